@@ -1,0 +1,84 @@
+"""The ``tribodem`` command (typer).
+
+Sub-commands live next to the rooms they drive; this file only wires them. Every
+user-facing error (bad config, bad input, numerical instability) becomes a one-line
+message and a non-zero exit code, never a traceback:
+exit 2 = bad input (refused before any work), exit 3 = run stopped (instability).
+"""
+
+from __future__ import annotations
+
+import sys
+
+import typer
+
+from tribodem import __version__
+from tribodem.io.config import ConfigError
+
+app = typer.Typer(
+    name="tribodem",
+    help="Wear at contact interfaces with particles (DEM, fretting FE-DE, cycle-jumping).",
+    no_args_is_help=True,
+    add_completion=False,
+    pretty_exceptions_enable=False,
+)
+
+
+def _version(value: bool) -> None:
+    if value:
+        typer.echo(f"tribodem {__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def _root(
+    version: bool = typer.Option(False, "--version", callback=_version, is_eager=True,
+                                 help="Print the version and exit."),
+) -> None:
+    """tribodem: wear at contact interfaces with particles."""
+
+
+def _register() -> None:
+    from tribodem.dem.cli import bench_app, dem_app
+
+    app.add_typer(dem_app, name="dem")
+    app.add_typer(bench_app, name="bench")
+    # -- sub-apps of other rooms are registered below this line --
+    try:
+        from tribodem.cyclejump_cli import jump_app
+    except ImportError:  # pragma: no cover - room not installed yet
+        pass
+    else:
+        app.add_typer(jump_app, name="jump")
+
+
+_register()
+
+
+def main() -> None:
+    """Entry point: run the app, mapping known errors to messages and exit codes."""
+    from tribodem.dem.errors import SimulationUnstable
+
+    try:
+        app(standalone_mode=False)
+    except ConfigError as err:
+        typer.echo(f"error: {err}", err=True)
+        sys.exit(2)
+    except SimulationUnstable as err:
+        typer.echo(f"run stopped: {err}", err=True)
+        sys.exit(3)
+    except typer.Exit as e:
+        sys.exit(e.exit_code)
+    except typer.Abort:
+        sys.exit(1)
+    except Exception as err:  # click usage errors
+        import click
+
+        if isinstance(err, click.exceptions.ClickException):
+            err.show()
+            sys.exit(2)
+        raise
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,1 @@
+"""Input/output: validated configs, atomic result files, VTK snapshots."""

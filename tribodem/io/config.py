@@ -1,0 +1,97 @@
+"""TOML configs -> validated pydantic models, with errors a user can act on.
+
+A bad value is refused before any work: the message names the field, the value given
+and what is allowed (``ConfigError``; the CLI turns it into exit code 2, no traceback).
+"""
+
+from __future__ import annotations
+
+import tomllib
+from pathlib import Path
+from typing import Any, TypeVar
+
+from pydantic import BaseModel, ValidationError
+
+M = TypeVar("M", bound=BaseModel)
+
+
+class ConfigError(ValueError):
+    """A configuration value that cannot be used; the message says which and why."""
+
+
+def format_validation_error(err: ValidationError, source: str = "config") -> str:
+    """One line per bad field: ``source: field = value: what is allowed``."""
+    lines = []
+    for e in err.errors():
+        field = ".".join(str(p) for p in e["loc"]) or "(root)"
+        value = e.get("input", "<missing>")
+        msg = e["msg"]
+        ctx = e.get("ctx") or {}
+        allowed = ", ".join(f"{k} {v}" for k, v in ctx.items() if k != "error")
+        if e["type"] == "missing":
+            lines.append(f"{source}: field '{field}' is required")
+        else:
+            extra = f" (allowed: {allowed})" if allowed else ""
+            lines.append(f"{source}: field '{field}' = {value!r}: {msg}{extra}")
+    return "\n".join(lines)
+
+
+def validate(model: type[M], data: dict[str, Any], source: str = "config") -> M:
+    """Validate ``data`` against ``model`` or raise ``ConfigError`` with a readable message."""
+    try:
+        return model.model_validate(data)
+    except ValidationError as err:
+        raise ConfigError(format_validation_error(err, source)) from None
+
+
+def load_toml(path: str | Path) -> dict[str, Any]:
+    """Read a TOML file, turning syntax errors into ``ConfigError``."""
+    p = Path(path)
+    if not p.is_file():
+        raise ConfigError(f"config file '{p}' does not exist")
+    try:
+        with p.open("rb") as fh:
+            return tomllib.load(fh)
+    except tomllib.TOMLDecodeError as err:
+        raise ConfigError(f"config file '{p}' is not valid TOML: {err}") from None
+
+
+def load_config(model: type[M], path: str | Path) -> M:
+    """Load and validate a TOML config file."""
+    return validate(model, load_toml(path), source=str(path))
+
+
+def merge(base: dict[str, Any], override: dict[str, Any]) -> dict[str, Any]:
+    """Recursive dict merge (override wins); used for --quick presets over defaults."""
+    out = dict(base)
+    for k, v in override.items():
+        if isinstance(v, dict) and isinstance(out.get(k), dict):
+            out[k] = merge(out[k], v)
+        else:
+            out[k] = v
+    return out
+
+
+def dump_toml(data: dict[str, Any]) -> str:
+    """Minimal TOML writer for resolved configs (tables of scalars/lists)."""
+    def fmt(v: Any) -> str:
+        if isinstance(v, bool):
+            return "true" if v else "false"
+        if isinstance(v, str):
+            return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
+        if isinstance(v, (list, tuple)):
+            return "[" + ", ".join(fmt(x) for x in v) + "]"
+        if v is None:
+            return '"none"'
+        return repr(v)
+
+    scalars = [(k, v) for k, v in data.items() if not isinstance(v, dict)]
+    tables = [(k, v) for k, v in data.items() if isinstance(v, dict)]
+    out = [f"{k} = {fmt(v)}" for k, v in scalars]
+    for name, table in tables:
+        out.append(f"\n[{name}]")
+        out += [f"{k} = {fmt(v)}" for k, v in table.items() if not isinstance(v, dict)]
+        for sub, st in ((k, v) for k, v in table.items() if isinstance(v, dict)):
+            out.append(f"\n[{name}.{sub}]")
+            out += [f"{k} = {fmt(v)}" for k, v in st.items()]
+    return "\n".join(out) + "\n"
