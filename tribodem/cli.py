@@ -39,17 +39,12 @@ def _root(
 
 
 def _register() -> None:
+    from tribodem.cyclejump_cli import jump_app
     from tribodem.dem.cli import bench_app, dem_app
 
     app.add_typer(dem_app, name="dem")
     app.add_typer(bench_app, name="bench")
-    # -- sub-apps of other rooms are registered below this line --
-    try:
-        from tribodem.cyclejump_cli import jump_app
-    except ImportError:  # pragma: no cover - room not installed yet
-        pass
-    else:
-        app.add_typer(jump_app, name="jump")
+    app.add_typer(jump_app, name="jump")
 
 
 _register()

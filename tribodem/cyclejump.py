@@ -1,0 +1,724 @@
+"""Cycle-jumping strategies (seed 003, chapter 4 and appendix III; eq 2.20).
+
+A cycle-jumping strategy watches a per-cycle simulated quantity and, when the history
+looks safe, skips ``n`` cycles by extrapolating the state over them. One interface,
+:class:`JumpStrategy`, and five strategies:
+
+* :class:`ConstantJump` -- McColl's constant jump length (eq 2.20, section 4.2.1);
+* :class:`CojocaruJump` -- ratio of two adjacent slopes (eqs 4.1-4.2, section 4.2.2);
+* :class:`MovingGroupsJump` -- slopes of two abutting groups (eqs 4.3-4.4, section 4.2.3);
+* :class:`OverlappingGroupsJump` -- groups overlapping by half (eqs 4.5-4.6, section 4.2.4);
+* :class:`AdaptiveJump` -- polynomial fit, coefficient convergence, curvature check,
+  jump length and Taylor extrapolation (eqs 4.7-4.15, section 4.3) with the four
+  modifications of section 4.4.
+
+The state is the cumulative quantity (e.g. wear depth, m) after a cycle; it may be a
+scalar or an array (a whole wear profile), in which case every element is advanced by
+its own fitted rate. Protocol::
+
+    s.observe(0, state0)                 # initial state (cycle 0)
+    for each simulated cycle c:
+        s.observe(c, state)
+        n = s.propose_jump()
+        if n: state = s.extrapolate(state, n)   # state now at cycle c + n
+
+:func:`replay` runs that loop on a recorded series of per-cycle increments (appendix III
+reads ``Result.csv``), and :func:`synthetic_two_phase_series` makes a running-in + steady
+test series (seed figure 5.17).
+"""
+
+from __future__ import annotations
+
+import inspect
+import math
+from abc import ABC, abstractmethod
+from dataclasses import dataclass, field
+from typing import Any, ClassVar
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+State = float | NDArray[np.float64]
+
+#: Elements whose fitted rate is below this fraction of the largest |rate| carry no wear
+#: and are left out of the linearity tests (they are still extrapolated by their own rate).
+ACTIVE_FRACTION = 1e-3
+
+#: Jump proposed for a perfectly linear history with no cap (the replay clips it to the
+#: end of the series).
+UNBOUNDED_JUMP = 10**9
+
+
+def _as_2d(value: ArrayLike) -> NDArray[np.float64]:
+    return np.atleast_1d(np.asarray(value, dtype=float)).reshape(-1)
+
+
+def _active(rate: NDArray[np.float64]) -> NDArray[np.bool_]:
+    m = float(np.max(np.abs(rate))) if rate.size else 0.0
+    if m == 0.0:
+        return np.zeros(rate.shape, dtype=bool)
+    return np.abs(rate) >= ACTIVE_FRACTION * m
+
+
+def _restore(template: State, arr: NDArray[np.float64]) -> State:
+    if np.ndim(template) == 0:
+        return float(arr.reshape(-1)[0])
+    return arr.reshape(np.shape(template))
+
+
+class JumpStrategy(ABC):
+    """Common interface: ``observe`` a cycle, ``propose_jump``, ``extrapolate`` the state.
+
+    ``foundation`` is the number of simulated cycles the strategy needs before it can
+    propose any jump; a replay on fewer rows is refused.
+    """
+
+    name: ClassVar[str] = "base"
+
+    def __init__(self) -> None:
+        self.reset()
+
+    def reset(self) -> None:
+        """Forget all history."""
+        self._cycles: list[float] = []
+        self._states: list[NDArray[np.float64]] = []
+        self._shape: tuple[int, ...] | None = None
+        self.jumps: list[tuple[int, int]] = []  # (cycle the jump starts from, length)
+
+    @property
+    @abstractmethod
+    def foundation(self) -> int:
+        """Simulated cycles needed before the first jump can be proposed."""
+
+    def observe(self, cycle: int, value: State) -> None:
+        """Record the state (cumulative quantity) after a simulated cycle ``cycle``."""
+        if self._cycles and cycle <= self._cycles[-1]:
+            raise ValueError(f"cycle {cycle} is not after the last one ({self._cycles[-1]})")
+        if self._shape is None:
+            self._shape = np.shape(value)
+        self._cycles.append(float(cycle))
+        self._states.append(_as_2d(value))
+        self._after_observe(jumped=False)
+
+    def _after_observe(self, jumped: bool) -> None:  # noqa: B027 - optional hook
+        """Hook for strategies that update fits on every new point."""
+
+    @abstractmethod
+    def propose_jump(self) -> int:
+        """Number of cycles to skip now (0 = simulate the next cycle)."""
+
+    @abstractmethod
+    def _increment(self, n: int) -> NDArray[np.float64]:
+        """Extrapolated change of the state over the next ``n`` cycles."""
+
+    def extrapolate(self, state: State, n: int) -> State:
+        """State after skipping ``n`` cycles from the last observed one.
+
+        The jumped-to point is recorded as the strategy's latest point (appendix III
+        appends it to the fitted data), so the next ``observe`` is at cycle ``last + n + 1``.
+        """
+        if n <= 0:
+            return state
+        new = _as_2d(state) + self._increment(n)
+        start = int(self._cycles[-1])
+        self.jumps.append((start, int(n)))
+        self._cycles.append(float(start + n))
+        self._states.append(new)
+        self._after_observe(jumped=True)
+        return _restore(state, new)
+
+    def params(self) -> dict[str, Any]:
+        """The strategy's parameters (for reports)."""
+        names = [k for k in inspect.signature(type(self).__init__).parameters if k != "self"]
+        return {k: getattr(self, k) for k in names}
+
+
+class ConstantJump(JumpStrategy):
+    """McColl's constant jump (eq 2.20, section 4.2.1).
+
+    After every simulated cycle, jump ``jump_length - 1`` cycles assuming the wear rate of
+    that cycle stays constant: H_total = N * H^N. Default N = 20 (section 4.2.1; McColl
+    et al. used 30).
+    """
+
+    name = "constant"
+
+    def __init__(self, jump_length: int = 20) -> None:
+        if jump_length < 1:
+            raise ValueError("jump_length must be >= 1")
+        self.jump_length = int(jump_length)
+        super().__init__()
+
+    @property
+    def foundation(self) -> int:
+        return 1
+
+    def _rate(self) -> NDArray[np.float64]:
+        return (self._states[-1] - self._states[-2]) / (self._cycles[-1] - self._cycles[-2])
+
+    def propose_jump(self) -> int:
+        if len(self._cycles) < 2:
+            return 0
+        return self.jump_length - 1
+
+    def _increment(self, n: int) -> NDArray[np.float64]:
+        return n * self._rate()
+
+
+class _SlopeRatioJump(JumpStrategy):
+    """Shared machinery of the Cojocaru family (eqs 4.1-4.6).
+
+    Two groups of ``group_size`` consecutive points (cumulative state vs cycle) are fitted
+    with straight lines; their slopes s1 (older) and s2 (newer) give the ratio
+    r = (s2 - s1) / s1. Linear if |r| <= q_y (the seed's "<=?"; the absolute value is
+    taken so a falling rate is not read as linear). The jump length generalises eq 4.2 to
+    groups whose centres are ``spacing`` cycles apart: dx = floor(q_e * spacing / |r|),
+    i.e. the number of cycles over which the slope changes by the fraction q_e (for
+    Cojocaru, spacing = 1 and this is eq 4.2 exactly). The state is extrapolated with the
+    newest slope: state + dx * s2 (section 4.5). Groups never span a jump: after a jump
+    the history restarts at the jumped-to point, so each jump needs fresh evidence.
+    For an array state the worst element (largest |r|) decides.
+    """
+
+    group_size: int
+    q_y: float
+    q_e: float
+    max_jump: int | None
+
+    def _groups(self) -> tuple[slice, slice]:
+        raise NotImplementedError
+
+    def _span_needed(self) -> int:
+        raise NotImplementedError
+
+    def _spacing(self) -> float:
+        raise NotImplementedError
+
+    @property
+    def foundation(self) -> int:
+        return self._span_needed() - 1
+
+    def _after_observe(self, jumped: bool) -> None:
+        if jumped:  # evidence restarts at the jumped-to point
+            self._cycles = self._cycles[-1:]
+            self._states = self._states[-1:]
+
+    def _slope(self, sl: slice) -> NDArray[np.float64]:
+        x = np.asarray(self._cycles[sl])
+        y = np.vstack(self._states[sl])
+        xc = x - x.mean()
+        return (xc @ (y - y.mean(axis=0))) / (xc @ xc)
+
+    def ratio(self) -> float:
+        """Worst-element |r| of eq 4.1/4.3/4.5 on the latest points (nan if too few)."""
+        if len(self._cycles) < self._span_needed():
+            return math.nan
+        g1, g2 = self._groups()
+        s1, s2 = self._slope(g1), self._slope(g2)
+        act = _active(s2) & (s1 != 0)
+        if not np.any(act):
+            return math.nan
+        return float(np.max(np.abs((s2[act] - s1[act]) / s1[act])))
+
+    def reset(self) -> None:
+        super().reset()
+        #: (cycle, |r| or nan, proposed jump) per check: the figure 4.4/4.7/4.10 history
+        self.history: list[tuple[int, float, int]] = []
+
+    def propose_jump(self) -> int:
+        r = self.ratio()
+        n = 0
+        if math.isfinite(r) and r <= self.q_y:
+            dx = math.inf if r == 0 else self.q_e * self._spacing() / r
+            if self.max_jump is not None:
+                dx = min(dx, self.max_jump)
+            n = int(min(dx, UNBOUNDED_JUMP))
+        self.history.append((int(self._cycles[-1]), r, n))
+        return n
+
+    def _increment(self, n: int) -> NDArray[np.float64]:
+        _, g2 = self._groups()
+        return n * self._slope(g2)
+
+
+class CojocaruJump(_SlopeRatioJump):
+    """Cojocaru's slope ratio on three consecutive points (eqs 4.1-4.2, section 4.2.2).
+
+    r = (s_(n+1 to n+2) - s_(n to n+1)) / s_(n to n+1); jump if |r| <= q_y, by
+    dx = floor(q_e / |r|) cycles. Defaults q_y = 0.02, q_e = 0.05 (section 4.2.2).
+    ``max_jump`` (cycles, default none) caps dx; the seed sets no cap.
+    """
+
+    name = "cojocaru"
+
+    def __init__(self, q_y: float = 0.02, q_e: float = 0.05, max_jump: int | None = None) -> None:
+        self.group_size = 2
+        self.q_y = float(q_y)
+        self.q_e = float(q_e)
+        self.max_jump = None if max_jump is None else int(max_jump)
+        super().__init__()
+
+    def _span_needed(self) -> int:
+        return 3
+
+    def _groups(self) -> tuple[slice, slice]:
+        return slice(-3, -1), slice(-2, None)
+
+    def _spacing(self) -> float:
+        return 1.0
+
+
+class MovingGroupsJump(_SlopeRatioJump):
+    """Moving-average groups (eqs 4.3-4.4, section 4.2.3).
+
+    Two abutting groups of x points: r = (s_(n+x to n+2x) - s_(n to n+x)) / s_(n to n+x);
+    group centres are x cycles apart, dx = floor(q_e * x / |r|). Defaults x = 8,
+    q_y = 1, q_e = 0.1 % (table 4.1, the column in which the seed saw jumps).
+    """
+
+    name = "moving"
+
+    def __init__(self, group_size: int = 8, q_y: float = 1.0, q_e: float = 0.001,
+                 max_jump: int | None = None) -> None:
+        if group_size < 2:
+            raise ValueError("group_size must be >= 2")
+        self.group_size = int(group_size)
+        self.q_y = float(q_y)
+        self.q_e = float(q_e)
+        self.max_jump = None if max_jump is None else int(max_jump)
+        super().__init__()
+
+    def _span_needed(self) -> int:
+        return 2 * self.group_size
+
+    def _groups(self) -> tuple[slice, slice]:
+        x = self.group_size
+        return slice(-2 * x, -x), slice(-x, None)
+
+    def _spacing(self) -> float:
+        return float(self.group_size)
+
+
+class OverlappingGroupsJump(_SlopeRatioJump):
+    """Groups overlapping by half (eqs 4.5-4.6, section 4.2.4).
+
+    Groups (n .. n+x) and (n+x/2 .. n+1.5x) share x/2 points; centres are x/2 cycles
+    apart, dx = floor(q_e * (x/2) / |r|). Defaults x = 8, q_y = 1, q_e = 0.1 % (table 4.2).
+    """
+
+    name = "overlapping"
+
+    def __init__(self, group_size: int = 8, q_y: float = 1.0, q_e: float = 0.001,
+                 max_jump: int | None = None) -> None:
+        if group_size < 2 or group_size % 2:
+            raise ValueError("group_size must be an even number >= 2")
+        self.group_size = int(group_size)
+        self.q_y = float(q_y)
+        self.q_e = float(q_e)
+        self.max_jump = None if max_jump is None else int(max_jump)
+        super().__init__()
+
+    def _span_needed(self) -> int:
+        return self.group_size + self.group_size // 2
+
+    def _groups(self) -> tuple[slice, slice]:
+        x, h = self.group_size, self.group_size // 2
+        return slice(-(x + h), -h), slice(-x, None)
+
+    def _spacing(self) -> float:
+        return self.group_size / 2
+
+
+@dataclass
+class AdaptiveDiagnostics:
+    """Per-check record of the adaptive strategy (figure 4.12-style history)."""
+
+    cycle: list[int] = field(default_factory=list)
+    q_coef: list[float] = field(default_factory=list)  # max relative coefficient change
+    curvature: list[float] = field(default_factory=list)  # |f''| / |f'|, 1/cycle
+    proposed: list[int] = field(default_factory=list)
+
+
+class AdaptiveJump(JumpStrategy):
+    """Adaptive polynomial-convergence strategy (section 4.3) with section 4.4's fixes.
+
+    After every new point (simulated, or the jumped-to point as in appendix III) the
+    cumulative state w(n) is fitted with a polynomial of ``degree`` (3, eq 4.7) in
+    t = n - n_r, n_r the cycle where the current window (re)started (cycle 0 = origin at
+    first, as appendix III starts its data at (0, 0)). The fit uses the points after
+    n_r within the last ``window_fraction`` (1/2) of all cycles run (the moving window
+    the seed allows in section 4.3; ``None`` = every point since n_r, the seed's
+    preliminary version), never fewer than ``foundation_cycles`` (8, section 4.4).
+
+    1. Convergence (eqs 4.9-4.12): "safe" when every coefficient changed by at most
+       ``q_coef`` (2 %, section 4.3) relative to the previous fit. Decision: denominators
+       are floored at ``coef_floor`` x (fitted rise over the window) / span^k for the
+       coefficient of t^k, so a negligible term (the cubic term of a straight line)
+       cannot block convergence through a near-zero denominator.
+    2. Linearity (eq 4.13): f'' has units, so the dimensionless curvature
+       kappa = |f''| / |f'| (relative change of the rate per cycle, 1/cycle) is compared
+       with q_y. Decision: kappa is taken as the larger of its values at both ends of the
+       window (``curvature_over_window``), so a window still holding the running-in is
+       not called linear because its newest end happens to be straight.
+    3. Jump length (eq 4.13'): dx = floor(q_e |f'(t_end)| / |f''|) = floor(q_e / kappa),
+       q_e = 2 % (section 4.4): the cycles over which the rate changes by q_e.
+    4. Extrapolation (eq 4.15): state + dx f'(t_end); ``taylor_order=2`` adds
+       f'' dx^2 / 2 as appendix III does.
+
+    Section 4.4 modifications:
+
+    a. maximum jump length: ``max_jump_initial`` up to cycle ``max_jump_until`` (200),
+       then growing in proportion to the cycle number (L = L0 n / 200). L0 = 200 is the
+       seed's final variant (figure 4.16); 15 is the figure 4.15 variant;
+    b. decreasing q_y: ``q_y`` (0.5 %) up to cycle ``q_y_until`` (300, where appendix III
+       switches thresholds), then ``q_y_late`` (0.02 %, figure 4.16); since kappa <= q_y
+       means dx >= q_e / q_y, late jumps must be >= 100 cycles long. Appendix III also
+       lowers the polynomial degree after cycle 300 (to a straight line); decision:
+       ``degree_late`` = 2 after ``q_y_until`` (a line has no curvature left to check; the
+       end curvature of a cubic on noisy wear is too noisy for q_y = 0.02 %); ``None``
+       keeps ``degree`` throughout (the text's version);
+    c. maximum consecutive jumps: after ``max_consecutive_jumps`` (3) jumps separated
+       only by single simulated cycles, no jump until ``refit_cycles`` (8) new cycles were
+       simulated and a new converged fit exists;
+    d. moving window: at that point the old polynomial is abandoned and the window restarts
+       at the present cycle (``moving_window=True``).
+
+    For an array state every element is fitted; the worst element carrying wear decides
+    convergence and linearity, and each element is extrapolated by its own f'.
+    """
+
+    name = "adaptive"
+
+    def __init__(
+        self,
+        degree: int = 3,
+        degree_late: int | None = 2,
+        foundation_cycles: int = 8,
+        q_coef: float = 0.02,
+        coef_floor: float = 0.05,
+        q_y: float = 0.005,
+        q_y_late: float = 0.0002,
+        q_y_until: int = 300,
+        q_e: float = 0.02,
+        max_jump_initial: int = 200,
+        max_jump_until: int = 200,
+        max_consecutive_jumps: int = 3,
+        refit_cycles: int = 8,
+        moving_window: bool = True,
+        window_fraction: float | None = 0.5,
+        curvature_over_window: bool = True,
+        taylor_order: int = 1,
+    ) -> None:
+        if degree < 1:
+            raise ValueError("degree must be >= 1")
+        if taylor_order not in (1, 2):
+            raise ValueError("taylor_order must be 1 (eq 4.15) or 2 (appendix III)")
+        if foundation_cycles < degree + 1:
+            raise ValueError(f"foundation_cycles must be >= degree + 1 = {degree + 1}")
+        self.degree = int(degree)
+        if degree_late is not None and not 2 <= degree_late <= degree:
+            raise ValueError("degree_late must be None or in [2, degree]")
+        self.degree_late = None if degree_late is None else int(degree_late)
+        self.foundation_cycles = int(foundation_cycles)
+        self.q_coef = float(q_coef)
+        self.coef_floor = float(coef_floor)
+        self.q_y = float(q_y)
+        self.q_y_late = float(q_y_late)
+        self.q_y_until = int(q_y_until)
+        self.q_e = float(q_e)
+        self.max_jump_initial = int(max_jump_initial)
+        self.max_jump_until = int(max_jump_until)
+        self.max_consecutive_jumps = int(max_consecutive_jumps)
+        self.refit_cycles = int(refit_cycles)
+        self.moving_window = bool(moving_window)
+        if window_fraction is not None and not 0.0 < window_fraction <= 1.0:
+            raise ValueError("window_fraction must be in (0, 1] or None")
+        self.curvature_over_window = bool(curvature_over_window)
+        self.window_fraction = None if window_fraction is None else float(window_fraction)
+        self.taylor_order = int(taylor_order)
+        super().__init__()
+
+    def reset(self) -> None:
+        super().reset()
+        self._n0 = 0  # index of the window's first point in the history
+        self._coef: NDArray[np.float64] | None = None
+        self._prev: NDArray[np.float64] | None = None
+        self._consecutive = 0
+        self._since_reset = 0
+        self._blocked = False
+        self.diagnostics = AdaptiveDiagnostics()
+
+    @property
+    def foundation(self) -> int:
+        return self.foundation_cycles
+
+    def max_jump(self, cycle: float) -> int:
+        """Section 4.4 (a): maximum jump length at ``cycle``."""
+        if cycle <= self.max_jump_until:
+            return self.max_jump_initial
+        return int(self.max_jump_initial * cycle / self.max_jump_until)
+
+    def degree_at(self, cycle: float) -> int:
+        """Polynomial degree at ``cycle`` (``degree_late`` after ``q_y_until``)."""
+        if self.degree_late is not None and cycle > self.q_y_until:
+            return self.degree_late
+        return self.degree
+
+    def q_y_at(self, cycle: float) -> float:
+        """Section 4.4 (b): linearity threshold at ``cycle`` (1/cycle)."""
+        return self.q_y if cycle <= self.q_y_until else self.q_y_late
+
+    def _window(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Points of the fit window, t = cycle - reference cycle of the current window."""
+        cyc = np.asarray(self._cycles[self._n0:])
+        y = np.vstack(self._states[self._n0:])
+        if self.window_fraction is not None and len(cyc) > self.foundation_cycles:
+            start = cyc[-1] - self.window_fraction * (cyc[-1] - self._cycles[0])
+            k = min(int(np.searchsorted(cyc, start)), len(cyc) - self.foundation_cycles)
+            cyc, y = cyc[k:], y[k:]
+        return cyc - self._cycles[self._n0], y
+
+    def _after_observe(self, jumped: bool) -> None:
+        if jumped:
+            self._consecutive += 1
+        else:
+            self._since_reset += 1
+        t, y = self._window()
+        self._prev = self._coef
+        self._coef = None
+        deg = self.degree_at(self._cycles[-1])
+        if len(t) >= max(self.foundation_cycles, deg + 1):
+            # highest power first, shape (degree + 1, elements)
+            self._coef = np.polyfit(t, y, deg)
+
+    def _derivs(self, t: float) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        assert self._coef is not None
+        c = self._coef
+        p = np.arange(c.shape[0] - 1, -1, -1, dtype=float)[:, None]
+        d1 = np.sum(np.where(p >= 1, p * c * t ** np.maximum(p - 1, 0), 0.0), axis=0)
+        d2 = np.sum(np.where(p >= 2, p * (p - 1) * c * t ** np.maximum(p - 2, 0), 0.0), axis=0)
+        return d1, d2
+
+    def _converged(self, span: float, rise: NDArray[np.float64],
+                   act: NDArray[np.bool_]) -> float:
+        """Max relative coefficient change (eqs 4.9-4.12) over active elements.
+
+        Denominators are floored at ``coef_floor * rise / span**k`` for the coefficient of
+        t**k (``rise`` = fitted change of the state over the window, ``span`` its length).
+        """
+        assert self._coef is not None and self._prev is not None
+        c, prev = self._coef[:, act], self._prev[:, act]
+        p = np.arange(c.shape[0] - 1, -1, -1, dtype=float)[:, None]
+        floor = self.coef_floor * np.abs(rise[act])[None, :] / max(span, 1.0) ** p
+        denom = np.maximum(np.abs(prev), floor)
+        denom = np.where(denom > 0, denom, np.inf)
+        return float(np.max(np.abs(c - prev) / denom))
+
+    def _restart_window(self) -> None:
+        self._n0 = len(self._cycles) - 1
+        self._coef = None
+        self._prev = None
+
+    def propose_jump(self) -> int:
+        cycle = self._cycles[-1]
+        proposal = 0
+        qc = curv = math.nan
+        if self._consecutive >= self.max_consecutive_jumps and self.max_consecutive_jumps > 0:
+            # section 4.4 (c) + (d): too many jumps in a row -> block and restart window
+            self._consecutive = 0
+            self._since_reset = 0
+            self._blocked = True
+            if self.moving_window:
+                self._restart_window()
+        elif self._blocked and self._since_reset < self.refit_cycles:
+            pass
+        elif self._coef is not None and self._prev is not None and \
+                self._prev.shape == self._coef.shape:
+            self._blocked = False
+            t, y = self._window()
+            t_end = float(t[-1])
+            d1, d2 = self._derivs(t_end)
+            act = _active(d1)
+            if np.any(act):
+                rise = np.polyval(self._coef, t_end) - np.polyval(self._coef, float(t[0]))
+                qc = self._converged(t_end - float(t[0]), rise, act)
+                if self.curvature_over_window:
+                    d1s, d2s = self._derivs(float(t[0]))
+                    d2 = np.maximum(np.abs(d2), np.abs(d2s))
+                curv = float(np.max(np.abs(d2[act]) / np.abs(d1[act])))
+                if qc <= self.q_coef and curv <= self.q_y_at(cycle):
+                    dx = math.inf if curv == 0 else self.q_e / curv
+                    proposal = int(min(dx, self.max_jump(cycle), UNBOUNDED_JUMP))
+        if proposal == 0:
+            self._consecutive = 0
+        d = self.diagnostics
+        d.cycle.append(int(cycle))
+        d.q_coef.append(qc)
+        d.curvature.append(curv)
+        d.proposed.append(proposal)
+        return proposal
+
+    def _increment(self, n: int) -> NDArray[np.float64]:
+        t, _ = self._window()
+        d1, d2 = self._derivs(float(t[-1]))
+        inc = n * d1
+        if self.taylor_order == 2:
+            inc = inc + 0.5 * n * n * d2
+        return inc
+
+
+STRATEGIES: dict[str, type[JumpStrategy]] = {
+    "constant": ConstantJump,
+    "cojocaru": CojocaruJump,
+    "moving": MovingGroupsJump,
+    "overlapping": OverlappingGroupsJump,
+    "adaptive": AdaptiveJump,
+}
+
+
+def make_strategy(name: str, **params: Any) -> JumpStrategy:
+    """Build a strategy by name with keyword parameters (unknown keys raise TypeError)."""
+    try:
+        cls = STRATEGIES[name]
+    except KeyError:
+        raise ValueError(f"unknown strategy {name!r}; allowed: {', '.join(STRATEGIES)}") from None
+    return cls(**params)
+
+
+@dataclass
+class ReplayResult:
+    """Outcome of :func:`replay`. Values in the units of the increments."""
+
+    strategy: str
+    params: dict[str, Any]
+    cycles_total: int
+    cycles_simulated: int
+    cycles_saved_fraction: float
+    final_value: State
+    reference_final_value: State
+    relative_difference: float
+    max_relative_difference: float
+    jumps: list[tuple[int, int]]  # (cycle jumped from, number of cycles skipped)
+    cycles: NDArray[np.float64]  # cycles where the replay has a value
+    values: NDArray[np.float64]  # replayed state there
+    reference: NDArray[np.float64]  # reference cumulative state, every cycle
+    reference_cycles: NDArray[np.float64]
+
+    def summary(self) -> dict[str, Any]:
+        """JSON-ready summary (no per-cycle arrays)."""
+        def num(v: State) -> Any:
+            return float(v) if np.ndim(v) == 0 else np.asarray(v).tolist()
+        return {
+            "strategy": self.strategy,
+            "params": self.params,
+            "cycles_total": self.cycles_total,
+            "cycles_simulated": self.cycles_simulated,
+            "cycles_saved_fraction": self.cycles_saved_fraction,
+            "final_value": num(self.final_value),
+            "reference_final_value": num(self.reference_final_value),
+            "relative_difference": self.relative_difference,
+            "max_relative_difference": self.max_relative_difference,
+            "jumps": len(self.jumps),
+        }
+
+
+def _reldiff(a: NDArray[np.float64], b: NDArray[np.float64]) -> float:
+    """|a - b| / |b| (norms over elements for a profile); 0 where b is 0."""
+    nb = float(np.linalg.norm(b))
+    return float(np.linalg.norm(a - b)) / nb if nb > 0 else 0.0
+
+
+def replay(strategy: JumpStrategy, cycles: ArrayLike, increments: ArrayLike) -> ReplayResult:
+    """Replay a recorded run with cycle-jumping.
+
+    ``increments[i]`` is the quantity gained in cycle ``cycles[i]`` (scalar per row, or a
+    row of profile values: shape (N,) or (N, K)). Simulating a cycle = reading its row and
+    adding it to the state; a jump of n cycles skips n rows and adds the strategy's
+    extrapolation instead. The reference is the full cumulative sum. The relative
+    difference is |value - reference| / |reference| (Euclidean norms for a profile),
+    ``max_relative_difference`` is over every cycle where the replay has a value.
+    """
+    cyc = np.asarray(cycles, dtype=float).reshape(-1)
+    inc = np.asarray(increments, dtype=float)
+    n_rows = len(cyc)
+    if inc.shape[0] != n_rows:
+        raise ValueError("cycles and increments have different lengths")
+    if n_rows < strategy.foundation + 1:
+        raise ValueError(f"{n_rows} rows; the {strategy.name} strategy needs at least "
+                         f"{strategy.foundation + 1}")
+    if np.any(np.diff(cyc) <= 0):
+        raise ValueError("cycles must be strictly increasing")
+    ref = np.cumsum(inc, axis=0)
+    strategy.reset()
+    zero = np.zeros(inc.shape[1:]) if inc.ndim > 1 else 0.0
+    strategy.observe(int(cyc[0]) - 1, zero)
+    state: State = zero
+    out_c: list[float] = []
+    out_v: list[State] = []
+    simulated = 0
+    max_rd = 0.0
+    i = 0
+    while i < n_rows:
+        state = state + inc[i]
+        simulated += 1
+        strategy.observe(int(cyc[i]), state)
+        out_c.append(cyc[i])
+        out_v.append(state)
+        max_rd = max(max_rd, _reldiff(np.asarray(state), ref[i]))
+        n = min(strategy.propose_jump(), n_rows - 1 - i)
+        if n > 0:
+            state = strategy.extrapolate(state, n)
+            i += n
+            out_c.append(cyc[i])
+            out_v.append(state)
+            max_rd = max(max_rd, _reldiff(np.asarray(state), ref[i]))
+        i += 1
+    final = state
+    return ReplayResult(
+        strategy=strategy.name,
+        params=strategy.params(),
+        cycles_total=n_rows,
+        cycles_simulated=simulated,
+        cycles_saved_fraction=1.0 - simulated / n_rows,
+        final_value=final,
+        reference_final_value=ref[-1] if inc.ndim > 1 else float(ref[-1]),
+        relative_difference=_reldiff(np.asarray(final), ref[-1]),
+        max_relative_difference=max_rd,
+        jumps=list(strategy.jumps),
+        cycles=np.asarray(out_c),
+        values=np.asarray(out_v),
+        reference=ref,
+        reference_cycles=cyc,
+    )
+
+
+def two_phase_rate(cycles: ArrayLike, steady_rate: float = 1.0, ratio: float = 10.0,
+                   tau: float = 50.0) -> NDArray[np.float64]:
+    """Noise-free wear rate of :func:`synthetic_two_phase_series` (per cycle)."""
+    n = np.asarray(cycles, dtype=float)
+    return steady_rate * (1.0 + (ratio - 1.0) * np.exp(-(n - 1.0) / tau))
+
+
+def synthetic_two_phase_series(
+    n: int = 2000, ratio: float = 10.0, noise: float = 0.1, seed: int = 0,
+    steady_rate: float = 1.0, tau: float = 50.0,
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Running-in then steady wear (seed figure 5.17): ``(cycles, increments)``.
+
+    increment(c) = steady_rate * (1 + (ratio - 1) * exp(-(c - 1) / tau)) * (1 + noise * z),
+    c = 1..n, z ~ N(0, 1) i.i.d. (Gaussian multiplicative noise, ``numpy.random.default_rng
+    (seed)``). The first cycle wears ``ratio`` times the steady rate; the rate is within
+    1.5x of steady after c > 1 + tau * ln(2 (ratio - 1)) (145 cycles for the defaults).
+    ``ratio = 1`` gives a linear series. Units: those of ``steady_rate`` (e.g. m/cycle).
+    """
+    c = np.arange(1, n + 1, dtype=float)
+    rate = two_phase_rate(c, steady_rate, ratio, tau)
+    z = np.random.default_rng(seed).standard_normal(n)
+    return c, rate * (1.0 + noise * z)
+
+
+def transition_end(ratio: float = 10.0, tau: float = 50.0, factor: float = 1.5) -> float:
+    """Last cycle of the running-in transition: rate > ``factor`` x steady before it."""
+    if ratio <= factor:
+        return 0.0
+    return 1.0 + tau * math.log((ratio - 1.0) / (factor - 1.0))

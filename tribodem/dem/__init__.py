@@ -1,0 +1,25 @@
+"""tribodem.dem: the particle engine (2D disks with thickness, 3D spheres).
+
+Rooms, one concept each (JAX-MD style: plain kernels over arrays, small classes that
+wire them): ``state`` (particle arrays), ``space`` (box, periodic axes),
+``neighbors`` (cell-list Verlet lists), ``contact`` (contact laws), ``walls`` (planes,
+servo walls), ``integrate`` (central difference with damping, time-step estimates),
+``engine`` (``Simulation``: the step loop, checkpoints), ``recorders`` (CSV, VTK).
+"""
+
+from tribodem.dem.contact import Material
+from tribodem.dem.engine import Simulation
+from tribodem.dem.errors import SimulationUnstable, TimeStepError
+from tribodem.dem.space import Box
+from tribodem.dem.state import ParticleState
+from tribodem.dem.walls import PlaneWall
+
+__all__ = [
+    "Box",
+    "Material",
+    "ParticleState",
+    "PlaneWall",
+    "Simulation",
+    "SimulationUnstable",
+    "TimeStepError",
+]

@@ -1,0 +1,80 @@
+"""Engine throughput: particle-steps per second on the shared benchmark cases."""
+
+from __future__ import annotations
+
+import time
+from typing import Any
+
+import numba
+import numpy as np
+
+from tribodem.dem.bench_cases import BenchCase, compress2d_case, settle3d_case
+from tribodem.dem.contact import Material
+from tribodem.dem.engine import Simulation
+from tribodem.dem.space import Box
+from tribodem.dem.state import ParticleState
+from tribodem.dem.walls import PlaneWall
+
+CASES = {"settle3d": settle3d_case, "compress2d": compress2d_case}
+
+
+def simulation_from_case(case: BenchCase) -> Simulation:
+    """Build the tribodem simulation of a benchmark case (box walls, fixed dt)."""
+    mat = Material(name="bench", young=case.young, poisson=case.poisson, density=case.density,
+                   cor=case.cor, friction=case.friction, law=case.law,
+                   beta_n=0.1 if case.law == "linear" else 0.0)
+    p = ParticleState(dim=case.dim, pos=case.positions, radius=case.radii,
+                      density=case.density, thickness=case.thickness)
+    lo, hi = case.box_lo, case.box_hi
+    walls = []
+    if case.dim == 3:
+        walls = [PlaneWall([0, 0, lo[2]], [0, 0, 1], name="floor"),
+                 PlaneWall([lo[0], 0, 0], [1, 0, 0], name="x-"),
+                 PlaneWall([hi[0], 0, 0], [-1, 0, 0], name="x+"),
+                 PlaneWall([0, lo[1], 0], [0, 1, 0], name="y-"),
+                 PlaneWall([0, hi[1], 0], [0, -1, 0], name="y+")]
+    else:
+        v = case.wall_speed
+        walls = [PlaneWall([0, lo[1], 0], [0, 1, 0], mode="velocity", velocity=[0, v, 0],
+                           name="bottom"),
+                 PlaneWall([0, hi[1], 0], [0, -1, 0], mode="velocity", velocity=[0, -v, 0],
+                           name="top"),
+                 PlaneWall([lo[0], 0, 0], [1, 0, 0], name="left"),
+                 PlaneWall([hi[0], 0, 0], [-1, 0, 0], name="right")]
+    return Simulation(p, [mat], Box(lo, hi), walls=walls, gravity=case.gravity, dt=case.dt,
+                      skin=0.1 * 2.0 * float(case.radii.mean()))
+
+
+def run_case(name: str, n: int | None = None, steps: int | None = None,
+             threads: int | None = None) -> dict[str, Any]:
+    """Time ``steps`` steps of case ``name`` (after a short warm-up that compiles kernels)."""
+    if name not in CASES:
+        raise ValueError(f"bench: case = {name!r}: must be one of {sorted(CASES)}")
+    kw: dict[str, Any] = {}
+    if n is not None:
+        kw["n"] = n
+    if steps is not None:
+        kw["steps"] = steps
+    case = CASES[name](**kw)
+    if threads is not None:
+        numba.set_num_threads(int(threads))
+    warm = simulation_from_case(CASES[name](n=min(case.n, 5000), steps=10))
+    warm.step(10)
+    sim = simulation_from_case(case)
+    t0 = time.perf_counter()
+    sim.step(case.steps)
+    dt_wall = time.perf_counter() - t0
+    z = sim.p.pos[:, 2] if case.dim == 3 else sim.p.pos[:, 1]
+    return {
+        "code": "tribodem",
+        "case": name,
+        "particles": case.n,
+        "steps": case.steps,
+        "threads": numba.get_num_threads(),
+        "seconds": dt_wall,
+        "particle_steps_per_s": case.n * case.steps / dt_wall,
+        "contacts_end": sim.n_contacts(),
+        "neighbor_builds": sim.nl.builds,
+        "mean_height_end_m": float(np.mean(z)),
+        "dt_s": sim.dt,
+    }

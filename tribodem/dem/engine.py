@@ -1,0 +1,370 @@
+"""``Simulation``: the step loop that wires the kernels, plus checkpoints and stability checks.
+
+One step: (re)build the neighbour list if needed -> pair contact forces -> gather ->
+wall contacts -> extra interactions (bonds, thermal, ... added as ``Interaction``
+objects) -> central-difference update -> walls move (servo) -> periodic wrap.
+The engine knows nothing about brakes or fretting; applications compose it.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable
+from pathlib import Path
+from typing import Protocol
+
+import numpy as np
+
+from tribodem.dem import neighbors
+from tribodem.dem.contact import HIST, Material, gather, pair_forces, pair_table
+from tribodem.dem.errors import SimulationUnstable, TimeStepError
+from tribodem.dem.integrate import central_difference, critical_step
+from tribodem.dem.space import Box, wrap_positions
+from tribodem.dem.state import ParticleState
+from tribodem.dem.walls import PlaneWall, wall_forces
+from tribodem.io.results import write_npz
+
+CHECKPOINT_VERSION = 1
+
+
+class Interaction(Protocol):
+    """An extra force contribution (bonds, thermal loads, ...): adds into sim.force/torque."""
+
+    def compute(self, sim: Simulation) -> None: ...
+
+
+class Recorder(Protocol):
+    """Something that samples the simulation (CSV scalars, VTK snapshots)."""
+
+    def sample(self, sim: Simulation) -> None: ...
+
+    def close(self) -> None: ...
+
+
+class Simulation:
+    """A DEM simulation (SI units).
+
+    Parameters: particles, materials (indexed by ``particles.mat`` and wall
+    ``material``), box (periodic axes), walls, gravity (m/s^2), ``dt`` (s; ``None`` =
+    ``dt_safety`` x critical step), ``viscous_damping`` c (1/s, seed 000 eq 1 eta = c m),
+    ``local_damping`` alpha (PFC), ``skin`` (m; default 0.2 x mean radius).
+    A ``dt`` above the critical step is refused (``TimeStepError``) unless ``force_dt``.
+    """
+
+    def __init__(self, particles: ParticleState, materials: list[Material], box: Box,
+                 walls: list[PlaneWall] | None = None, gravity: tuple | np.ndarray = (0, 0, 0),
+                 dt: float | None = None, dt_safety: float = 0.2, viscous_damping: float = 0.0,
+                 local_damping: float = 0.0, skin: float | None = None,
+                 force_dt: bool = False, max_overlap_ratio: float = 0.5,
+                 check_every: int = 100, track_energy: bool = False) -> None:
+        self.p = particles
+        self.materials = list(materials)
+        self.box = box
+        self.walls = list(walls or [])
+        self.gravity = np.asarray(gravity, dtype=np.float64).reshape(3)
+        self.viscous_damping = float(viscous_damping)
+        self.local_damping = float(local_damping)
+        self.max_overlap_ratio = float(max_overlap_ratio)
+        self.check_every = int(check_every)
+        self.track_energy = bool(track_energy)
+        self._at_force_eval: tuple[np.ndarray, ...] | None = None
+        self.interactions: list[Interaction] = []
+        self.recorders: list[tuple[int, Recorder]] = []
+        self.step_count = 0
+        self.time = 0.0
+        self._validate(dt, dt_safety)
+        self.pairtab, self.elin = pair_table(self.materials)
+        n = self.p.n
+        self.force = np.zeros((n, 3))
+        self.torque = np.zeros((n, 3))
+        self.skin = float(skin) if skin is not None else 0.2 * float(self.p.radius.mean())
+        self.nl = neighbors.build(self.p.pos, self.p.radius, self.skin, box.lo, box.hi,
+                                  box.periodic)
+        self.hist = np.zeros((self.nl.n_pairs, HIST))
+        self._alloc_pairs()
+        self.wall_hist = np.zeros((len(self.walls), n, HIST))
+        self.wall_info = np.zeros((len(self.walls), n, 4))
+        self._fwall = np.zeros((n, 3))
+        self.dt_critical, self.dt_limit_by = critical_step(
+            self.p.density, self.p.radius, self.p.mass, self.p.inertia, self.p.mat,
+            self.nl.pair_i, self.nl.pair_j, self.pairtab, self.elin, self.materials, self.p.dim,
+            self.p.thickness, self.p.pos, self.walls, self.skin)
+        if dt is None:
+            self.dt = dt_safety * self.dt_critical
+        else:
+            if dt > self.dt_critical and not force_dt:
+                raise TimeStepError(
+                    f"dt = {dt:.6g} s is above the critical time step {self.dt_critical:.6g} s "
+                    f"limited by {self.dt_limit_by}; use dt <= {self.dt_critical:.6g} s "
+                    "(or force_dt=True)")
+            self.dt = float(dt)
+
+    # ------------------------------------------------------------------ setup
+    def _validate(self, dt: float | None, dt_safety: float) -> None:
+        nm = len(self.materials)
+        if nm == 0:
+            raise ValueError("simulation: at least one material is needed")
+        if self.p.n and (self.p.mat.min() < 0 or self.p.mat.max() >= nm):
+            raise ValueError(f"particles: mat index {int(self.p.mat.max())} is out of range: "
+                             f"{nm} materials given")
+        for w in self.walls:
+            if not 0 <= w.material < nm:
+                raise ValueError(f"wall '{w.name}': material = {w.material}: must be in "
+                                 f"[0, {nm - 1}]")
+        if dt is not None and not dt > 0:
+            raise ValueError(f"simulation: dt = {dt!r}: must be > 0 s")
+        if not 0 < dt_safety <= 1:
+            raise ValueError(f"simulation: dt_safety = {dt_safety!r}: must be in (0, 1]")
+        if not 0 <= self.local_damping < 1:
+            raise ValueError(f"simulation: local_damping = {self.local_damping!r}: must be in "
+                             "[0, 1)")
+        if not self.viscous_damping >= 0:
+            raise ValueError(f"simulation: viscous_damping = {self.viscous_damping!r}: must "
+                             "be >= 0 1/s")
+        rmax = float(self.p.radius.max()) if self.p.n else 0.0
+        for k in range(3):
+            if self.box.periodic[k] and self.box.length[k] < 4.0 * rmax * 1.2:
+                raise ValueError(f"box: periodic axis {k} length {self.box.length[k]:.4g} m is "
+                                 f"below 4.8 x the largest radius ({rmax:.4g} m)")
+
+    def _alloc_pairs(self) -> None:
+        m = self.nl.n_pairs
+        self.fpair = np.zeros((m, 3))
+        self.tpair_i = np.zeros((m, 3))
+        self.tpair_j = np.zeros((m, 3))
+        self.pinfo = np.zeros((m, 4))
+
+    def add_interaction(self, inter: Interaction) -> None:
+        """Add an extra force contribution, evaluated every step after contacts."""
+        self.interactions.append(inter)
+
+    def add_recorder(self, recorder: Recorder, every: int) -> None:
+        """Sample ``recorder`` every ``every`` steps (and once at the start)."""
+        if every < 1:
+            raise ValueError(f"recorder: every = {every!r}: must be >= 1 step")
+        self.recorders.append((int(every), recorder))
+
+    # ------------------------------------------------------------------ stepping
+    def _maybe_rebuild(self) -> None:
+        drift = neighbors.max_drift.pick(self.p.n)(self.p.pos, self.nl.ref_pos, self.p.radius,
+                                    self.nl.ref_radius, self.box.length, self.box.periodic)
+        if drift <= 0.5 * self.skin:
+            return
+        old, old_hist = self.nl, self.hist
+        self.nl = neighbors.build(self.p.pos, self.p.radius, self.skin, self.box.lo,
+                                  self.box.hi, self.box.periodic, old.builds)
+        self.hist = np.zeros((self.nl.n_pairs, HIST))
+        neighbors.transfer_history.pick(self.p.n)(old.start, old.pair_j, old_hist, self.nl.start,
+                                   self.nl.pair_j, self.hist)
+        self._alloc_pairs()
+
+    def compute_forces(self) -> None:
+        """Contact, wall and extra forces for the current positions and velocities."""
+        p = self.p
+        pair_forces.pick(self.nl.n_pairs)(p.pos, p.vel, p.omega, p.radius, p.mass, p.inertia, p.mat,
+                    self.nl.pair_i, self.nl.pair_j, self.hist, self.pairtab, self.elin,
+                    self.box.length, self.box.periodic, p.dim, p.thickness, self.dt,
+                    self.fpair, self.tpair_i, self.tpair_j, self.pinfo)
+        gather.pick(p.n)(self.nl.start, self.nl.rev_start, self.nl.rev_pair, self.fpair,
+                         self.tpair_i, self.tpair_j, self.force, self.torque)
+        for w_id, w in enumerate(self.walls):
+            wall_forces.pick(p.n)(p.pos, p.vel, p.omega, p.radius, p.mass, p.inertia, p.mat,
+                        w.point, w.normal, w.velocity, w.material, self.wall_hist[w_id],
+                        self.pairtab,
+                        self.elin, p.dim, p.thickness, self.dt, self.force, self.torque,
+                        self._fwall, self.wall_info[w_id])
+            w.force = self._fwall.sum(axis=0)
+            w.normal_force = -float(w.force @ w.normal)
+            info = self.wall_info[w_id]
+            touching = info[:, 1] != 0.0
+            w.contacts = int(np.count_nonzero(touching))
+            w.stiffness = float(info[touching, 3].sum())
+        for inter in self.interactions:
+            inter.compute(self)
+
+    def step(self, n: int = 1) -> None:
+        """Advance ``n`` steps. Raises ``SimulationUnstable`` (recorders flushed) on blow-up."""
+        try:
+            if self.step_count == 0 and self.time == 0.0:
+                self._sample(force=True)
+            for _ in range(n):
+                self._maybe_rebuild()
+                self.compute_forces()
+                p = self.p
+                if self.track_energy:
+                    self._at_force_eval = (p.pos.copy(), p.vel.copy(), p.omega.copy())
+                central_difference.pick(p.n)(p.pos, p.vel, p.omega, self.force, self.torque, p.mass,
+                                   p.inertia, p.fixed, self.gravity, self.dt,
+                                   self.viscous_damping, self.local_damping, p.dim)
+                for w in self.walls:
+                    w.update_motion(self.dt)
+                if self.box.periodic.any():
+                    wrap_positions.pick(p.n)(p.pos, self.box.lo, self.box.length, self.box.periodic)
+                self.step_count += 1
+                self.time += self.dt
+                if self.step_count % self.check_every == 0:
+                    self.check_stability()
+                self._sample()
+        except SimulationUnstable:
+            self.close_recorders()
+            raise
+
+    def run(self, steps: int, progress: bool = False, chunk: int = 1000) -> None:
+        """Advance ``steps`` steps, optionally with a progress bar."""
+        if not progress:
+            self.step(steps)
+            return
+        from tqdm import tqdm
+
+        with tqdm(total=steps, unit="step", leave=False) as bar:
+            done = 0
+            while done < steps:
+                k = min(chunk, steps - done)
+                self.step(k)
+                done += k
+                bar.update(k)
+
+    def _sample(self, force: bool = False) -> None:
+        for every, rec in self.recorders:
+            if force or self.step_count % every == 0:
+                rec.sample(self)
+
+    def close_recorders(self) -> None:
+        """Flush and close all recorders (outputs so far are kept)."""
+        for _, rec in self.recorders:
+            rec.close()
+
+    def check_stability(self) -> None:
+        """Stop with a reason if positions/velocities are not finite or overlaps run away."""
+        p = self.p
+        bad = ~np.isfinite(p.pos).all(axis=1) | ~np.isfinite(p.vel).all(axis=1)
+        if bad.any():
+            i = int(np.flatnonzero(bad)[0])
+            raise SimulationUnstable(
+                f"step {self.step_count} (t = {self.time:.6g} s): particle {i} has a non-finite "
+                f"position or velocity; time step {self.dt:.4g} s vs critical "
+                f"{self.dt_critical:.4g} s ({self.dt_limit_by})")
+        if self.nl.n_pairs:
+            rmin = np.minimum(p.radius[self.nl.pair_i], p.radius[self.nl.pair_j])
+            ratio = self.pinfo[:, 0] / rmin
+            q = int(np.argmax(ratio))
+            if ratio[q] > self.max_overlap_ratio:
+                raise SimulationUnstable(
+                    f"step {self.step_count} (t = {self.time:.6g} s): overlap of pair "
+                    f"({int(self.nl.pair_i[q])}, {int(self.nl.pair_j[q])}) is {ratio[q]:.3g} of "
+                    f"the smaller radius (limit {self.max_overlap_ratio}): the load is too high "
+                    f"for the stiffness or the time step {self.dt:.4g} s is too large")
+
+    # ------------------------------------------------------------------ measurements
+    def kinetic_energy(self) -> float:
+        """Translational + rotational kinetic energy (J) at the current (half-step) velocities."""
+        p = self.p
+        with np.errstate(over="ignore", invalid="ignore"):
+            return float(0.5 * (p.mass * (p.vel**2).sum(axis=1)).sum()
+                         + 0.5 * (p.inertia * (p.omega**2).sum(axis=1)).sum())
+
+    def elastic_energy(self) -> float:
+        """Energy stored in contact springs (pairs and walls) at the last force evaluation (J)."""
+        e = float(self.pinfo[:, 2].sum())
+        for w_id in range(len(self.walls)):
+            e += float(self.wall_info[w_id, :, 2].sum())
+        return e
+
+    def total_energy(self) -> float:
+        """Kinetic + elastic + gravity energy (J) at the last force evaluation (integer step).
+
+        Needs ``track_energy=True``: the leapfrog velocity at the step is the mean of the
+        half-step velocities around it.
+        """
+        if self._at_force_eval is None:
+            raise RuntimeError("total_energy needs Simulation(track_energy=True) and one step")
+        x, v0, w0 = self._at_force_eval
+        p = self.p
+        v = 0.5 * (v0 + p.vel)
+        w = 0.5 * (w0 + p.omega)
+        ke = 0.5 * (p.mass * (v**2).sum(axis=1)).sum() + 0.5 * (p.inertia * (w**2).sum(axis=1)
+                                                                 ).sum()
+        return float(ke) + self.elastic_energy() - float((p.mass * (x @ self.gravity)).sum())
+
+    def gravity_energy(self) -> float:
+        """Potential energy in the gravity field (J), zero at the origin."""
+        return float(-(self.p.mass * (self.p.pos @ self.gravity)).sum())
+
+    def n_contacts(self) -> int:
+        """Particle-particle contacts carrying force."""
+        return int(np.count_nonzero(self.pinfo[:, 0] > 0))
+
+    def contacts(self) -> dict[str, np.ndarray]:
+        """Active particle-particle contacts: i, j, overlap (m), normal force (N, + = push),
+        force vector on j (N)."""
+        act = self.pinfo[:, 0] > 0
+        return {"i": self.nl.pair_i[act], "j": self.nl.pair_j[act],
+                "overlap": self.pinfo[act, 0], "normal_force": self.pinfo[act, 1],
+                "force": self.fpair[act]}
+
+    # ------------------------------------------------------------------ checkpoints
+    def save_checkpoint(self, path: str | Path) -> Path:
+        """Write the full state atomically (``.npz``): resuming gives bitwise the same run."""
+        arrays: dict[str, np.ndarray] = {f"p_{k}": v for k, v in self.p.arrays().items()}
+        arrays.update({
+            "nl_start": self.nl.start, "nl_pair_i": self.nl.pair_i, "nl_pair_j": self.nl.pair_j,
+            "nl_rev_start": self.nl.rev_start, "nl_rev_pair": self.nl.rev_pair,
+            "nl_ref_pos": self.nl.ref_pos, "nl_ref_radius": self.nl.ref_radius,
+            "hist": self.hist, "wall_hist": self.wall_hist, "wall_info": self.wall_info,
+            "pinfo": self.pinfo, "force": self.force, "torque": self.torque,
+        })
+        for w_id, w in enumerate(self.walls):
+            for k, v in w.state().items():
+                arrays[f"w{w_id}_{k}"] = v
+        meta = {"version": CHECKPOINT_VERSION, "step": self.step_count, "time": self.time,
+                "dt": self.dt, "nl_builds": self.nl.builds, "skin": self.skin,
+                "n": self.p.n}
+        arrays["meta"] = np.array(json.dumps(meta))
+        arrays["time_exact"] = np.array([self.time])
+        return write_npz(path, **arrays)
+
+    def load_checkpoint(self, path: str | Path) -> None:
+        """Restore a checkpoint written by ``save_checkpoint`` into this (same-setup) simulation."""
+        with np.load(path, allow_pickle=False) as z:
+            meta = json.loads(str(z["meta"]))
+            if meta.get("version") != CHECKPOINT_VERSION:
+                raise ValueError(f"checkpoint '{path}': version {meta.get('version')} is not "
+                                 f"supported (expected {CHECKPOINT_VERSION})")
+            if meta["n"] != self.p.n:
+                raise ValueError(f"checkpoint '{path}': {meta['n']} particles, but the "
+                                 f"simulation has {self.p.n}")
+            for k in self.p.arrays():
+                setattr(self.p, k, z[f"p_{k}"].copy())
+            self.p.update_mass()
+            self.nl = neighbors.NeighborList(
+                z["nl_start"].copy(), z["nl_pair_i"].copy(), z["nl_pair_j"].copy(),
+                z["nl_rev_start"].copy(), z["nl_rev_pair"].copy(), z["nl_ref_pos"].copy(),
+                z["nl_ref_radius"].copy(), float(meta["skin"]), int(meta["nl_builds"]))
+            self.skin = float(meta["skin"])
+            self._alloc_pairs()
+            self.hist = z["hist"].copy()
+            self.wall_hist = z["wall_hist"].copy()
+            self.wall_info = z["wall_info"].copy()
+            self.pinfo = z["pinfo"].copy()
+            self.force = z["force"].copy()
+            self.torque = z["torque"].copy()
+            for w_id, w in enumerate(self.walls):
+                w.set_state({k: z[f"w{w_id}_{k}"] for k in ("point", "velocity", "force",
+                                                            "scalars")})
+            self.step_count = int(meta["step"])
+            self.time = float(z["time_exact"][0])
+            self.dt = float(meta["dt"])
+
+
+def settle_until(sim: Simulation, done: Callable[[Simulation], bool], max_steps: int,
+                 check: int = 100) -> int:
+    """Step in chunks of ``check`` until ``done(sim)`` or ``max_steps``; returns steps run."""
+    steps = 0
+    while steps < max_steps:
+        sim.step(check)
+        steps += check
+        if done(sim):
+            break
+    return steps
+
+

@@ -1,0 +1,60 @@
+"""The simulation box: bounds and periodic axes (seed 000 fig. 7 remapping)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from numba import njit, prange
+
+from tribodem.dem.jit import kernel
+
+
+@dataclass
+class Box:
+    """Axis-aligned box [lo, hi) in m; ``periodic[k]`` makes axis k periodic.
+
+    Non-periodic axes only bound the cell grid (particles may leave them; walls confine).
+    """
+
+    lo: np.ndarray
+    hi: np.ndarray
+    periodic: np.ndarray = field(default_factory=lambda: np.zeros(3, dtype=np.bool_))
+
+    def __post_init__(self) -> None:
+        self.lo = np.asarray(self.lo, dtype=np.float64).reshape(3)
+        self.hi = np.asarray(self.hi, dtype=np.float64).reshape(3)
+        self.periodic = np.asarray(self.periodic, dtype=np.bool_).reshape(3)
+        for k in range(3):
+            if self.periodic[k] and not self.hi[k] > self.lo[k]:
+                raise ValueError(f"box: periodic axis {k} needs hi > lo (got {self.lo[k]}, "
+                                 f"{self.hi[k]})")
+
+    @property
+    def length(self) -> np.ndarray:
+        """Box edge lengths (m); zero-length non-periodic axes are allowed (2D z)."""
+        return self.hi - self.lo
+
+
+@njit(cache=True, inline="always")
+def min_image(d: float, length: float, periodic: bool) -> float:
+    """Minimum-image component of a separation along one axis."""
+    if periodic:
+        return d - length * np.rint(d / length)
+    return d
+
+
+@kernel
+def wrap_positions(pos: np.ndarray, lo: np.ndarray, length: np.ndarray,
+                   periodic: np.ndarray) -> None:
+    """Map positions on periodic axes back into [lo, lo + L) (in place)."""
+    n = pos.shape[0]
+    for i in prange(n):
+        for k in range(3):
+            if periodic[k]:
+                x = pos[i, k] - lo[k]
+                if x < 0.0 or x >= length[k]:
+                    x -= length[k] * np.floor(x / length[k])
+                    if x >= length[k]:
+                        x -= length[k]
+                    pos[i, k] = lo[k] + x

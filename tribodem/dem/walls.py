@@ -1,0 +1,155 @@
+"""Plane walls: fixed, velocity-controlled and servo (force-controlled) walls.
+
+A wall is an infinite plane through ``point`` with unit ``normal`` pointing to the
+particle side; it contacts particle i when the distance d < r_i (overlap r_i - d),
+through the same contact laws as particles (wall radius and mass infinite).
+
+Servo modes (the wall moves along its normal, i.e. towards the particles):
+- ``"servo"`` (PFC): ``v = G (F_target - F_int)``, ``G = alpha / (sum kn dt)``,
+  alpha = 0.25 (the Hertz dashpot stiffens the wall response; PFC's usual 0.5 rang);
+- ``"boundary"`` (seed 003 eqs 3.2-3.6, boundary-moving method):
+  ``a = (F_target - F_int - C v) / M``, ``v += a dt``, ``d = v dt``.
+F_int is the normal force the particles press on the wall (N, compressive +).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from numba import prange
+
+from tribodem.dem.contact import P_LAW, contact_response
+from tribodem.dem.jit import kernel
+
+WALL_MODES = ("fixed", "velocity", "servo", "boundary")
+
+
+@dataclass
+class PlaneWall:
+    """A plane wall (SI). ``target_force`` (N) is used by the servo modes.
+
+    ``servo_mass`` (kg) and ``servo_damping`` (N s/m) are M and C_c of seed 003 eq 3.6;
+    ``servo_gain_alpha`` is the PFC gain factor; ``max_speed`` caps servo speed (m/s).
+    """
+
+    point: np.ndarray
+    normal: np.ndarray
+    material: int = 0
+    mode: str = "fixed"
+    velocity: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    target_force: float = 0.0
+    servo_mass: float = 1.0
+    servo_damping: float = 0.0
+    servo_gain_alpha: float = 0.25
+    max_speed: float = np.inf
+    name: str = "wall"
+    # state
+    force: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    normal_force: float = 0.0
+    stiffness: float = 0.0
+    contacts: int = 0
+
+    def __post_init__(self) -> None:
+        self.point = np.asarray(self.point, dtype=np.float64).reshape(3).copy()
+        nrm = np.asarray(self.normal, dtype=np.float64).reshape(3)
+        ln = float(np.linalg.norm(nrm))
+        if not ln > 0:
+            raise ValueError(f"wall '{self.name}': normal = {nrm.tolist()}: must be non-zero")
+        self.normal = nrm / ln
+        self.velocity = np.asarray(self.velocity, dtype=np.float64).reshape(3).copy()
+        self.force = np.asarray(self.force, dtype=np.float64).reshape(3).copy()
+        if self.mode not in WALL_MODES:
+            raise ValueError(f"wall '{self.name}': mode = {self.mode!r}: must be one of "
+                             f"{WALL_MODES}")
+        if self.mode == "boundary" and not self.servo_mass > 0:
+            raise ValueError(f"wall '{self.name}': servo_mass = {self.servo_mass!r}: must be "
+                             "> 0 kg")
+
+    def update_motion(self, dt: float) -> None:
+        """Advance the wall one step: servo velocity from the measured force, then move."""
+        if self.mode == "servo":
+            err = self.target_force - self.normal_force
+            if self.stiffness > 0:
+                speed = self.servo_gain_alpha * err / (self.stiffness * dt)
+            else:  # no contact yet: approach at the cap (or a nominal pace)
+                speed = self.max_speed if np.isfinite(self.max_speed) else 0.0
+            speed = float(np.clip(speed, -self.max_speed, self.max_speed))
+            self.velocity = speed * self.normal
+        elif self.mode == "boundary":
+            v = float(self.velocity @ self.normal)  # speed towards the particles
+            a = (self.target_force - self.normal_force - self.servo_damping * v) / self.servo_mass
+            v = float(np.clip(v + a * dt, -self.max_speed, self.max_speed))
+            self.velocity = v * self.normal
+        self.point = self.point + self.velocity * dt
+
+    def state(self) -> dict[str, np.ndarray]:
+        """Mutable state for checkpoints."""
+        return {"point": self.point.copy(), "velocity": self.velocity.copy(),
+                "force": self.force.copy(),
+                "scalars": np.array([self.normal_force, self.stiffness, self.contacts])}
+
+    def set_state(self, s: dict[str, np.ndarray]) -> None:
+        """Restore the state saved by ``state``."""
+        self.point = s["point"].copy()
+        self.velocity = s["velocity"].copy()
+        self.force = s["force"].copy()
+        self.normal_force, self.stiffness, c = (float(x) for x in s["scalars"])
+        self.contacts = int(c)
+
+
+@kernel
+def wall_forces(pos, vel, omega, radius, mass, inertia, mat, point, normal, wvel, wmat,
+                hist, pairtab, elin, dim, thickness, dt, force, torque, fwall, info):
+    """Contacts of every particle with one plane wall; adds to force/torque.
+
+    hist[i]: shear spring of particle i on this wall. fwall[i]: force on the wall from
+    particle i. info[i] = (overlap, normal force, energy, kn).
+    """
+    n = pos.shape[0]
+    for i in prange(n):
+        d = ((pos[i, 0] - point[0]) * normal[0] + (pos[i, 1] - point[1]) * normal[1]
+             + (pos[i, 2] - point[2]) * normal[2])
+        r = radius[i]
+        delta = r - d
+        if delta <= 0.0:
+            for k in range(3):
+                hist[i, k] = 0.0
+                fwall[i, k] = 0.0
+            info[i, 0] = delta
+            info[i, 1] = 0.0
+            info[i, 2] = 0.0
+            info[i, 3] = 0.0
+            continue
+        nn = -normal  # from particle (body 1) to wall (body 2)
+        arm = d
+        wi = omega[i]
+        c0 = wi[1] * nn[2] - wi[2] * nn[1]
+        c1 = wi[2] * nn[0] - wi[0] * nn[2]
+        c2 = wi[0] * nn[1] - wi[1] * nn[0]
+        vrel = np.empty(3)
+        vrel[0] = wvel[0] - (vel[i, 0] + arm * c0)
+        vrel[1] = wvel[1] - (vel[i, 1] + arm * c1)
+        vrel[2] = wvel[2] - (vel[i, 2] + arm * c2)
+        area = 2.0 * r * thickness if dim == 2 else np.pi * r * r
+        # PFC ball-facet: L = r; modulus = harmonic mean of particle and wall moduli
+        lin_k = area * 2.0 / (1.0 / elin[mat[i]] + 1.0 / elin[wmat]) / r
+        prop = pairtab[mat[i], wmat]
+        out = np.empty(9)
+        contact_response(int(prop[P_LAW]), prop, nn, delta, vrel, omega[i], r, mass[i],
+                         inertia[i], area, lin_k, hist[i], dt, out)
+        # force on particle = -out[0:3]; torque on particle = arm n x (-F) + rolling
+        f0, f1, f2 = out[0], out[1], out[2]
+        force[i, 0] -= f0
+        force[i, 1] -= f1
+        force[i, 2] -= f2
+        torque[i, 0] += -arm * (nn[1] * f2 - nn[2] * f1) + out[3]
+        torque[i, 1] += -arm * (nn[2] * f0 - nn[0] * f2) + out[4]
+        torque[i, 2] += -arm * (nn[0] * f1 - nn[1] * f0) + out[5]
+        fwall[i, 0] = f0
+        fwall[i, 1] = f1
+        fwall[i, 2] = f2
+        info[i, 0] = delta
+        info[i, 1] = out[6]
+        info[i, 2] = out[7]
+        info[i, 3] = out[8]
