@@ -75,20 +75,21 @@ def settle3d_case(n: int = 20_000, steps: int = 2_000, seed: int = 0) -> BenchCa
 def compress2d_case(n: int = 50_000, steps: int = 2_000, seed: int = 0) -> BenchCase:
     """Case (b): n linear-contact disks (unit thickness) compressed by two platens.
 
-    Square lattice, spacing 7.2 um (the braking particle size of seed 000), radii uniform
-    in [3.42, 3.6] um, E 200 GPa (PFC deformability kn = 2 r t E*/(r1+r2)),
+    Square lattice of spacing 7.15 um with radii uniform in [3.58, 3.6] um (the braking
+    particle size of seed 000), so every lattice neighbour starts in contact (overlap
+    0.01-0.05 um); E 200 GPa (PFC deformability kn = 2 r t E*/(r1+r2)),
     rho 7850; the top and bottom platens approach at 0.1 m/s each (the seed's calibration
     speed); dt = 0.2 x sqrt(m_min / kn_max).
     """
     rng = np.random.default_rng(seed)
-    s = 7.2e-6
+    s = 7.15e-6
     nx = int(math.ceil(math.sqrt(n)))
     ny = int(math.ceil(n / nx))
     idx = np.arange(n)
     i, j = idx % nx, idx // nx
     pos = np.stack([(i + 0.5) * s, (j + 0.5) * s, np.zeros(n)], axis=1)
-    pos[:, :2] += rng.uniform(-0.01, 0.01, size=(n, 2)) * s
-    radii = rng.uniform(3.42e-6, 3.6e-6, size=n)
+    pos[:, :2] += rng.uniform(-0.001, 0.001, size=(n, 2)) * s
+    radii = rng.uniform(3.58e-6, 3.6e-6, size=n)
     young, nu, rho = 2.0e11, 0.3, 7850.0
     t = 1.0
     m_min = rho * math.pi * radii.min() ** 2 * t
