@@ -431,6 +431,8 @@ def main(argv=None) -> list[dict]:
     ap.add_argument("--repeat", type=int, default=1, help="runs per point; fastest is kept")
     ap.add_argument("--wait-idle", type=float, default=0.0, metavar="S",
                     help="before each run wait up to S s until 'threads' CPUs are idle")
+    ap.add_argument("--strict-idle", action="store_true",
+                    help="with --wait-idle: wait for *all* CPUs to be idle, not just 'threads'")
     ap.add_argument("--workdir", default=None, help="keep inputs/logs here (default: temp)")
     args = ap.parse_args(argv)
     bc = _load_cases()
@@ -443,7 +445,8 @@ def main(argv=None) -> list[dict]:
             for t in args.threads:
                 runs = []
                 for _ in range(max(1, args.repeat)):
-                    busy = _wait_idle(args.wait_idle, t) if args.wait_idle > 0 else None
+                    need = (os.cpu_count() or 1) if args.strict_idle else t
+                    busy = _wait_idle(args.wait_idle, need) if args.wait_idle > 0 else None
                     res = runners[code](case, t, workdir)
                     if res is None:
                         break

@@ -166,7 +166,7 @@ def set_pair(tab: np.ndarray, a: int, b: int, ma: Material, mb: Material, **over
 
 
 @njit(cache=True, inline="always")
-def law_normal(law, prop, delta, vn, rstar, mstar, area, lin_k):
+def law_normal(law, prop, delta, vn, rstar, mstar, _area, lin_k):
     """Normal force magnitude (N, + = repulsive), tangential stiffness (N/m), tangential
     damping coefficient (N s/m), normal stiffness (N/m) and stored energy (J)."""
     if law == HERTZ:
@@ -187,64 +187,79 @@ def law_normal(law, prop, delta, vn, rstar, mstar, area, lin_k):
 
 
 @njit(cache=True, inline="always")
-def contact_response(law, prop, n, delta, vrel, wrel, rstar, mstar, istar, area, lin_k, hist,
-                     dt, out):
+def contact_response(law, prop, n0, n1, n2, delta, v0, v1, v2, w0, w1, w2, rstar, mstar, istar,
+                     lin_k, hist, dt):
     """Force on the second body and rolling torque on the first, for one contact.
 
-    n: unit normal from body 1 to body 2; vrel: velocity of body 2 minus body 1 at the
-    contact point; wrel: omega_1 - omega_2. ``hist`` (shear spring, m) is updated in
-    place. Writes out[0:3] force on body 2 (N), out[3:6] rolling torque on body 1
-    (N m; body 2 gets minus it), out[6] normal force, out[7] energy, out[8] kn.
+    n: unit normal from body 1 to body 2; v: velocity of body 2 minus body 1 at the
+    contact point; w: omega_1 - omega_2. ``hist`` (shear spring, m) is updated in place.
+    Returns (force on body 2 (3, N), rolling torque on body 1 (3, N m; body 2 gets minus
+    it), normal force N, stored energy J, normal stiffness N/m). Scalars only: no
+    allocation in the hot loop.
     """
-    vn = vrel[0] * n[0] + vrel[1] * n[1] + vrel[2] * n[2]
-    fn, kt, ct, kn, energy = law_normal(law, prop, delta, vn, rstar, mstar, area, lin_k)
+    vn = v0 * n0 + v1 * n1 + v2 * n2
+    fn, kt, ct, kn, energy = law_normal(law, prop, delta, vn, rstar, mstar, 0.0, lin_k)
     # shear spring: rotate into the current tangent plane (keep its length), add slip
-    hn = hist[0] * n[0] + hist[1] * n[1] + hist[2] * n[2]
-    h0 = np.sqrt(hist[0] ** 2 + hist[1] ** 2 + hist[2] ** 2)
-    for k in range(3):
-        hist[k] -= hn * n[k]
-    h1 = np.sqrt(hist[0] ** 2 + hist[1] ** 2 + hist[2] ** 2)
-    if h1 > 0.0:
-        s = h0 / h1
-        for k in range(3):
-            hist[k] *= s
-    vt = np.empty(3)
-    for k in range(3):
-        vt[k] = vrel[k] - vn * n[k]
-        hist[k] += vt[k] * dt
-    ft = np.empty(3)
-    for k in range(3):
-        ft[k] = -kt * hist[k] - ct * vt[k]
-    ftm = np.sqrt(ft[0] ** 2 + ft[1] ** 2 + ft[2] ** 2)
+    h0, h1, h2 = hist[0], hist[1], hist[2]
+    hn = h0 * n0 + h1 * n1 + h2 * n2
+    len0 = np.sqrt(h0 * h0 + h1 * h1 + h2 * h2)
+    h0 -= hn * n0
+    h1 -= hn * n1
+    h2 -= hn * n2
+    len1 = np.sqrt(h0 * h0 + h1 * h1 + h2 * h2)
+    if len1 > 0.0:
+        sc = len0 / len1
+        h0 *= sc
+        h1 *= sc
+        h2 *= sc
+    vt0 = v0 - vn * n0
+    vt1 = v1 - vn * n1
+    vt2 = v2 - vn * n2
+    h0 += vt0 * dt
+    h1 += vt1 * dt
+    h2 += vt2 * dt
+    ft0 = -kt * h0 - ct * vt0
+    ft1 = -kt * h1 - ct * vt1
+    ft2 = -kt * h2 - ct * vt2
+    ftm = np.sqrt(ft0 * ft0 + ft1 * ft1 + ft2 * ft2)
     fmax = prop[P_MU] * (fn if fn > 0.0 else 0.0)
     if ftm > fmax:
-        s = fmax / ftm if ftm > 0.0 else 0.0
-        for k in range(3):
-            ft[k] *= s
-            hist[k] = -(ft[k] + ct * vt[k]) / kt if kt > 0.0 else 0.0
-    energy += 0.5 * kt * (hist[0] ** 2 + hist[1] ** 2 + hist[2] ** 2)
-    for k in range(3):
-        out[k] = fn * n[k] + ft[k]
+        sc = fmax / ftm if ftm > 0.0 else 0.0
+        ft0 *= sc
+        ft1 *= sc
+        ft2 *= sc
+        if kt > 0.0:
+            h0 = -(ft0 + ct * vt0) / kt
+            h1 = -(ft1 + ct * vt1) / kt
+            h2 = -(ft2 + ct * vt2) / kt
+        else:
+            h0 = 0.0
+            h1 = 0.0
+            h2 = 0.0
+    hist[0] = h0
+    hist[1] = h1
+    hist[2] = h2
+    energy += 0.5 * kt * (h0 * h0 + h1 * h1 + h2 * h2)
     # rolling resistance (constant directional torque), without reversing the spin
+    r0 = 0.0
+    r1 = 0.0
+    r2 = 0.0
     mur = prop[P_MUR]
-    for k in range(3):
-        out[3 + k] = 0.0
     if mur > 0.0 and fn > 0.0:
-        wn = wrel[0] * n[0] + wrel[1] * n[1] + wrel[2] * n[2]
-        wr = np.empty(3)
-        for k in range(3):
-            wr[k] = wrel[k] - wn * n[k]
-        wm = np.sqrt(wr[0] ** 2 + wr[1] ** 2 + wr[2] ** 2)
+        wn = w0 * n0 + w1 * n1 + w2 * n2
+        wr0 = w0 - wn * n0
+        wr1 = w1 - wn * n1
+        wr2 = w2 - wn * n2
+        wm = np.sqrt(wr0 * wr0 + wr1 * wr1 + wr2 * wr2)
         if wm > 0.0:
             tq = mur * fn * rstar
             tlim = istar * wm / dt
             if tq > tlim:
                 tq = tlim
-            for k in range(3):
-                out[3 + k] = -tq * wr[k] / wm
-    out[6] = fn
-    out[7] = energy
-    out[8] = kn
+            r0 = -tq * wr0 / wm
+            r1 = -tq * wr1 / wm
+            r2 = -tq * wr2 / wm
+    return (fn * n0 + ft0, fn * n1 + ft1, fn * n2 + ft2, r0, r1, r2, fn, energy, kn)
 
 
 @kernel
@@ -259,11 +274,10 @@ def pair_forces(pos, vel, omega, radius, mass, inertia, mat, pair_i, pair_j, his
     for p in prange(m):
         i = pair_i[p]
         j = pair_j[p]
-        d = np.empty(3)
-        d[0] = min_image(pos[j, 0] - pos[i, 0], length[0], periodic[0])
-        d[1] = min_image(pos[j, 1] - pos[i, 1], length[1], periodic[1])
-        d[2] = min_image(pos[j, 2] - pos[i, 2], length[2], periodic[2])
-        dist = np.sqrt(d[0] ** 2 + d[1] ** 2 + d[2] ** 2)
+        d0 = min_image(pos[j, 0] - pos[i, 0], length[0], periodic[0])
+        d1 = min_image(pos[j, 1] - pos[i, 1], length[1], periodic[1])
+        d2 = min_image(pos[j, 2] - pos[i, 2], length[2], periodic[2])
+        dist = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
         ri = radius[i]
         rj = radius[j]
         delta = ri + rj - dist
@@ -278,25 +292,17 @@ def pair_forces(pos, vel, omega, radius, mass, inertia, mat, pair_i, pair_j, his
             pinfo[p, 2] = 0.0
             pinfo[p, 3] = 0.0
             continue
-        n = d / dist
+        n0 = d0 / dist
+        n1 = d1 / dist
+        n2 = d2 / dist
         ai = ri - 0.5 * delta
         aj = rj - 0.5 * delta
-        vrel = np.empty(3)
-        wrel = np.empty(3)
-        # v_c = v + omega x (arm): body i arm +ai n, body j arm -aj n
-        wi = omega[i]
-        wj = omega[j]
-        ci0 = wi[1] * n[2] - wi[2] * n[1]
-        ci1 = wi[2] * n[0] - wi[0] * n[2]
-        ci2 = wi[0] * n[1] - wi[1] * n[0]
-        cj0 = wj[1] * n[2] - wj[2] * n[1]
-        cj1 = wj[2] * n[0] - wj[0] * n[2]
-        cj2 = wj[0] * n[1] - wj[1] * n[0]
-        vrel[0] = (vel[j, 0] - aj * cj0) - (vel[i, 0] + ai * ci0)
-        vrel[1] = (vel[j, 1] - aj * cj1) - (vel[i, 1] + ai * ci1)
-        vrel[2] = (vel[j, 2] - aj * cj2) - (vel[i, 2] + ai * ci2)
-        for k in range(3):
-            wrel[k] = wi[k] - wj[k]
+        # v_c = v + omega x arm: body i arm +ai n, body j arm -aj n
+        wi0, wi1, wi2 = omega[i, 0], omega[i, 1], omega[i, 2]
+        wj0, wj1, wj2 = omega[j, 0], omega[j, 1], omega[j, 2]
+        v0 = (vel[j, 0] - aj * (wj1 * n2 - wj2 * n1)) - (vel[i, 0] + ai * (wi1 * n2 - wi2 * n1))
+        v1 = (vel[j, 1] - aj * (wj2 * n0 - wj0 * n2)) - (vel[i, 1] + ai * (wi2 * n0 - wi0 * n2))
+        v2 = (vel[j, 2] - aj * (wj0 * n1 - wj1 * n0)) - (vel[i, 2] + ai * (wi0 * n1 - wi1 * n0))
         rstar = ri * rj / (ri + rj)
         mstar = mass[i] * mass[j] / (mass[i] + mass[j])
         istar = inertia[i] * inertia[j] / (inertia[i] + inertia[j])
@@ -304,27 +310,26 @@ def pair_forces(pos, vel, omega, radius, mass, inertia, mat, pair_i, pair_j, his
         area = 2.0 * rmin * thickness if dim == 2 else np.pi * rmin * rmin
         lin_k = area / (ri / elin[mat[i]] + rj / elin[mat[j]])
         prop = pairtab[mat[i], mat[j]]
-        out = np.empty(9)
-        contact_response(int(prop[P_LAW]), prop, n, delta, vrel, wrel, rstar, mstar, istar,
-                         area, lin_k, hist[p], dt, out)
-        f0, f1, f2 = out[0], out[1], out[2]
+        f0, f1, f2, r0, r1, r2, fn, energy, kn = contact_response(
+            int(prop[P_LAW]), prop, n0, n1, n2, delta, v0, v1, v2, wi0 - wj0, wi1 - wj1,
+            wi2 - wj2, rstar, mstar, istar, lin_k, hist[p], dt)
         fpair[p, 0] = f0
         fpair[p, 1] = f1
         fpair[p, 2] = f2
         # torque = arm x force; body j: (-aj n) x F ; body i: (ai n) x (-F)
-        tx = n[1] * f2 - n[2] * f1
-        ty = n[2] * f0 - n[0] * f2
-        tz = n[0] * f1 - n[1] * f0
-        tpair_i[p, 0] = -ai * tx + out[3]
-        tpair_i[p, 1] = -ai * ty + out[4]
-        tpair_i[p, 2] = -ai * tz + out[5]
-        tpair_j[p, 0] = -aj * tx - out[3]
-        tpair_j[p, 1] = -aj * ty - out[4]
-        tpair_j[p, 2] = -aj * tz - out[5]
+        tx = n1 * f2 - n2 * f1
+        ty = n2 * f0 - n0 * f2
+        tz = n0 * f1 - n1 * f0
+        tpair_i[p, 0] = -ai * tx + r0
+        tpair_i[p, 1] = -ai * ty + r1
+        tpair_i[p, 2] = -ai * tz + r2
+        tpair_j[p, 0] = -aj * tx - r0
+        tpair_j[p, 1] = -aj * ty - r1
+        tpair_j[p, 2] = -aj * tz - r2
         pinfo[p, 0] = delta
-        pinfo[p, 1] = out[6]
-        pinfo[p, 2] = out[7]
-        pinfo[p, 3] = out[8]
+        pinfo[p, 1] = fn
+        pinfo[p, 2] = energy
+        pinfo[p, 3] = kn
 
 
 @kernel

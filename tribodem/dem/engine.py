@@ -21,7 +21,7 @@ from tribodem.dem.errors import SimulationUnstable, TimeStepError
 from tribodem.dem.integrate import central_difference, critical_step
 from tribodem.dem.space import Box, wrap_positions
 from tribodem.dem.state import ParticleState
-from tribodem.dem.walls import PlaneWall, wall_forces
+from tribodem.dem.walls import PlaneWall, wall_forces, wall_totals
 from tribodem.io.results import write_npz
 
 CHECKPOINT_VERSION = 1
@@ -173,12 +173,9 @@ class Simulation:
                         self.pairtab,
                         self.elin, p.dim, p.thickness, self.dt, self.force, self.torque,
                         self._fwall, self.wall_info[w_id])
-            w.force = self._fwall.sum(axis=0)
+            fx, fy, fz, w.contacts, w.stiffness = wall_totals(self._fwall, self.wall_info[w_id])
+            w.force = np.array([fx, fy, fz])
             w.normal_force = -float(w.force @ w.normal)
-            info = self.wall_info[w_id]
-            touching = info[:, 1] != 0.0
-            w.contacts = int(np.count_nonzero(touching))
-            w.stiffness = float(info[touching, 3].sum())
         for inter in self.interactions:
             inter.compute(self)
 

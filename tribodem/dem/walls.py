@@ -17,7 +17,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-from numba import prange
+from numba import njit, prange
 
 from tribodem.dem.contact import P_LAW, contact_response
 from tribodem.dem.jit import kernel
@@ -121,35 +121,54 @@ def wall_forces(pos, vel, omega, radius, mass, inertia, mat, point, normal, wvel
             info[i, 2] = 0.0
             info[i, 3] = 0.0
             continue
-        nn = -normal  # from particle (body 1) to wall (body 2)
+        # unit normal from the particle (body 1) to the wall (body 2)
+        n0 = -normal[0]
+        n1 = -normal[1]
+        n2 = -normal[2]
         arm = d
-        wi = omega[i]
-        c0 = wi[1] * nn[2] - wi[2] * nn[1]
-        c1 = wi[2] * nn[0] - wi[0] * nn[2]
-        c2 = wi[0] * nn[1] - wi[1] * nn[0]
-        vrel = np.empty(3)
-        vrel[0] = wvel[0] - (vel[i, 0] + arm * c0)
-        vrel[1] = wvel[1] - (vel[i, 1] + arm * c1)
-        vrel[2] = wvel[2] - (vel[i, 2] + arm * c2)
+        w0, w1, w2 = omega[i, 0], omega[i, 1], omega[i, 2]
+        v0 = wvel[0] - (vel[i, 0] + arm * (w1 * n2 - w2 * n1))
+        v1 = wvel[1] - (vel[i, 1] + arm * (w2 * n0 - w0 * n2))
+        v2 = wvel[2] - (vel[i, 2] + arm * (w0 * n1 - w1 * n0))
         area = 2.0 * r * thickness if dim == 2 else np.pi * r * r
         # PFC ball-facet: L = r; modulus = harmonic mean of particle and wall moduli
         lin_k = area * 2.0 / (1.0 / elin[mat[i]] + 1.0 / elin[wmat]) / r
         prop = pairtab[mat[i], wmat]
-        out = np.empty(9)
-        contact_response(int(prop[P_LAW]), prop, nn, delta, vrel, omega[i], r, mass[i],
-                         inertia[i], area, lin_k, hist[i], dt, out)
-        # force on particle = -out[0:3]; torque on particle = arm n x (-F) + rolling
-        f0, f1, f2 = out[0], out[1], out[2]
+        f0, f1, f2, r0, r1, r2, fn, energy, kn = contact_response(
+            int(prop[P_LAW]), prop, n0, n1, n2, delta, v0, v1, v2, w0, w1, w2, r, mass[i],
+            inertia[i], lin_k, hist[i], dt)
+        # force on particle = -F; torque on particle = (arm n) x (-F) + rolling
         force[i, 0] -= f0
         force[i, 1] -= f1
         force[i, 2] -= f2
-        torque[i, 0] += -arm * (nn[1] * f2 - nn[2] * f1) + out[3]
-        torque[i, 1] += -arm * (nn[2] * f0 - nn[0] * f2) + out[4]
-        torque[i, 2] += -arm * (nn[0] * f1 - nn[1] * f0) + out[5]
+        torque[i, 0] += -arm * (n1 * f2 - n2 * f1) + r0
+        torque[i, 1] += -arm * (n2 * f0 - n0 * f2) + r1
+        torque[i, 2] += -arm * (n0 * f1 - n1 * f0) + r2
         fwall[i, 0] = f0
         fwall[i, 1] = f1
         fwall[i, 2] = f2
         info[i, 0] = delta
-        info[i, 1] = out[6]
-        info[i, 2] = out[7]
-        info[i, 3] = out[8]
+        info[i, 1] = fn
+        info[i, 2] = energy
+        info[i, 3] = kn
+
+
+@njit(cache=True)
+def wall_totals(fwall, info):
+    """Total force on the wall (N), number of touching particles, sum of their kn (N/m).
+
+    Serial and in particle order, so the servo sees the same value on any thread count.
+    """
+    fx = 0.0
+    fy = 0.0
+    fz = 0.0
+    count = 0
+    ksum = 0.0
+    for i in range(fwall.shape[0]):
+        if info[i, 1] != 0.0:
+            fx += fwall[i, 0]
+            fy += fwall[i, 1]
+            fz += fwall[i, 2]
+            count += 1
+            ksum += info[i, 3]
+    return fx, fy, fz, count, ksum
