@@ -268,7 +268,24 @@ class CojocaruJump(_SlopeRatioJump):
         return 1.0
 
 
-class MovingGroupsJump(_SlopeRatioJump):
+class _GroupsJump(_SlopeRatioJump):
+    """Slope ratio of two groups of ``group_size`` cycles (sections 4.2.3-4.2.4)."""
+
+    even_groups = False
+
+    def __init__(self, group_size: int = 8, q_y: float = 1.0, q_e: float = 0.001,
+                 max_jump: int | None = None) -> None:
+        if group_size < 2 or (self.even_groups and group_size % 2):
+            kind = "an even number" if self.even_groups else "a whole number"
+            raise ValueError(f"group_size must be {kind} >= 2")
+        self.group_size = int(group_size)
+        self.q_y = float(q_y)
+        self.q_e = float(q_e)
+        self.max_jump = None if max_jump is None else int(max_jump)
+        super().__init__()
+
+
+class MovingGroupsJump(_GroupsJump):
     """Moving-average groups (eqs 4.3-4.4, section 4.2.3).
 
     Two abutting groups of x points: r = (s_(n+x to n+2x) - s_(n to n+x)) / s_(n to n+x);
@@ -277,16 +294,6 @@ class MovingGroupsJump(_SlopeRatioJump):
     """
 
     name = "moving"
-
-    def __init__(self, group_size: int = 8, q_y: float = 1.0, q_e: float = 0.001,
-                 max_jump: int | None = None) -> None:
-        if group_size < 2:
-            raise ValueError("group_size must be >= 2")
-        self.group_size = int(group_size)
-        self.q_y = float(q_y)
-        self.q_e = float(q_e)
-        self.max_jump = None if max_jump is None else int(max_jump)
-        super().__init__()
 
     def _span_needed(self) -> int:
         return 2 * self.group_size
@@ -299,7 +306,7 @@ class MovingGroupsJump(_SlopeRatioJump):
         return float(self.group_size)
 
 
-class OverlappingGroupsJump(_SlopeRatioJump):
+class OverlappingGroupsJump(_GroupsJump):
     """Groups overlapping by half (eqs 4.5-4.6, section 4.2.4).
 
     Groups (n .. n+x) and (n+x/2 .. n+1.5x) share x/2 points; centres are x/2 cycles
@@ -307,16 +314,7 @@ class OverlappingGroupsJump(_SlopeRatioJump):
     """
 
     name = "overlapping"
-
-    def __init__(self, group_size: int = 8, q_y: float = 1.0, q_e: float = 0.001,
-                 max_jump: int | None = None) -> None:
-        if group_size < 2 or group_size % 2:
-            raise ValueError("group_size must be an even number >= 2")
-        self.group_size = int(group_size)
-        self.q_y = float(q_y)
-        self.q_e = float(q_e)
-        self.max_jump = None if max_jump is None else int(max_jump)
-        super().__init__()
+    even_groups = True
 
     def _span_needed(self) -> int:
         return self.group_size + self.group_size // 2
