@@ -215,6 +215,8 @@ def run_yade(case, threads: int, workdir, timeout: float = TIMEOUT_S) -> dict | 
         "verlet_dist": 0.5 * skin_length(case),
         "final": str(wd / "final.txt"), "result": str(wd / "result.json"),
     }
+    for stale in ("result.json", "final.txt"):
+        (wd / stale).unlink(missing_ok=True)
     (wd / "params.json").write_text(json.dumps(params, indent=1))
     script = wd / "yade_case.py"
     script.write_text(_YADE_SCRIPT % {"params": str(wd / "params.json")})
@@ -239,7 +241,8 @@ def run_yade(case, threads: int, workdir, timeout: float = TIMEOUT_S) -> dict | 
         "code": "yade", "version": raw["version"], "case": case.name,
         "particles": case.n, "steps": int(case.steps), "threads": int(raw["threads"]),
         "seconds": raw["seconds"], "particle_steps_per_s": case.n * case.steps / raw["seconds"],
-        "contacts_end": raw["contacts_pp"] + raw["contacts_wall"],
+        # contacts_end: sphere-sphere contacts, as for LIGGGHTS; wall contacts separately
+        "contacts_end": raw["contacts_pp"],
         "contacts_end_pp": raw["contacts_pp"], "contacts_end_wall": raw["contacts_wall"],
         "cpu_per_wall": raw["cpu_seconds"] / raw["seconds"],
         "skin_m": skin_length(case), "others_cpu_frac": others, "command": " ".join(cmd),
