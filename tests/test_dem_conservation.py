@@ -7,7 +7,6 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from tribodem.dem import Box, Material, ParticleState, PlaneWall, Simulation
-from tribodem.dem.contact import HIST, gather, pair_forces, pair_table
 
 
 def gas_box(law: str, n_side: int = 10, seed: int = 0) -> Simulation:
@@ -66,23 +65,13 @@ def test_pair_forces_equal_and_opposite(d, vi, vj, wi, wj, ri, rj, overlap, law,
     pos = np.array([[0.0, 0, 0], n * dist])
     mat = Material(young=1e6, poisson=0.25, density=1000, friction=0.4, cor=0.6, law=law,
                    kratio=1.5, beta_n=0.3, beta_s=0.2, rolling_friction=0.1)
-    tab, elin = pair_table([mat])
-    radius = np.array([ri, rj])
-    mass = 1000 * 4 / 3 * np.pi * radius**3
-    inertia = 0.4 * mass * radius**2
-    h = np.array([hist], dtype=float) * 0.01
-    f = np.zeros((1, 3))
-    ti = np.zeros((1, 3))
-    tj = np.zeros((1, 3))
-    info = np.zeros((1, 4))
-    pair_forces.serial(pos, np.array([vi, vj], float), np.array([wi, wj], float), radius, mass,
-                       inertia, np.zeros(2, np.int32), np.array([0]), np.array([1]), h, tab,
-                       elin, np.ones(3), np.zeros(3, np.bool_), 3, 1.0, 1e-3, f, ti, tj, info)
-    force = np.zeros((2, 3))
-    torque = np.zeros((2, 3))
-    gather.serial(np.array([0, 1, 1]), np.array([0, 0, 1]), np.array([0]), f, ti, tj, force,
-                  torque)
-    assert h.shape[1] == HIST
+    p = ParticleState(dim=3, pos=pos, radius=[ri, rj], density=1000, vel=[vi, vj],
+                      omega=[wi, wj])
+    sim = Simulation(p, [mat], Box([-5, -5, -5], [5, 5, 5]), dt=1e-3, force_dt=True)
+    sim.hist[:] = np.array([hist], dtype=float) * 0.01
+    sim.step(1)  # sim.force / sim.torque: the totals the particles received in that step
+    force, torque = sim.force, sim.torque
+    assert sim.n_contacts() == 1
     scale = np.abs(force).max() + 1e-30
     np.testing.assert_allclose(force[0], -force[1], atol=1e-12 * scale)
     # total angular momentum change about the origin vanishes (rolling torque is pair-balanced)

@@ -42,7 +42,7 @@ def simulation_from_case(case: BenchCase) -> Simulation:
                  PlaneWall([lo[0], 0, 0], [1, 0, 0], name="left"),
                  PlaneWall([hi[0], 0, 0], [-1, 0, 0], name="right")]
     return Simulation(p, [mat], Box(lo, hi), walls=walls, gravity=case.gravity, dt=case.dt,
-                      skin=0.1 * 2.0 * float(case.radii.mean()))
+                      skin=0.15 * 2.0 * float(case.radii.mean()))
 
 
 def run_case(name: str, n: int | None = None, steps: int | None = None,

@@ -262,7 +262,7 @@ def contact_response(law, prop, n0, n1, n2, delta, v0, v1, v2, w0, w1, w2, rstar
     return (fn * n0 + ft0, fn * n1 + ft1, fn * n2 + ft2, r0, r1, r2, fn, energy, kn)
 
 
-@kernel
+@kernel(chunk=512)
 def pair_forces(pos, vel, omega, radius, mass, inertia, mat, pair_i, pair_j, hist, pairtab,
                 elin, length, periodic, dim, thickness, dt, fpair, tpair_i, tpair_j, pinfo):
     """Forces of all listed pairs (prange over pairs; no shared writes).
@@ -330,37 +330,3 @@ def pair_forces(pos, vel, omega, radius, mass, inertia, mat, pair_i, pair_j, his
         pinfo[p, 1] = fn
         pinfo[p, 2] = energy
         pinfo[p, 3] = kn
-
-
-@kernel
-def gather(start, rev_start, rev_pair, fpair, tpair_i, tpair_j, force, torque):
-    """Sum pair forces/torques onto particles (fixed order: deterministic)."""
-    n = force.shape[0]
-    for i in prange(n):
-        fx = 0.0
-        fy = 0.0
-        fz = 0.0
-        tx = 0.0
-        ty = 0.0
-        tz = 0.0
-        for p in range(start[i], start[i + 1]):
-            fx -= fpair[p, 0]
-            fy -= fpair[p, 1]
-            fz -= fpair[p, 2]
-            tx += tpair_i[p, 0]
-            ty += tpair_i[p, 1]
-            tz += tpair_i[p, 2]
-        for q in range(rev_start[i], rev_start[i + 1]):
-            p = rev_pair[q]
-            fx += fpair[p, 0]
-            fy += fpair[p, 1]
-            fz += fpair[p, 2]
-            tx += tpair_j[p, 0]
-            ty += tpair_j[p, 1]
-            tz += tpair_j[p, 2]
-        force[i, 0] = fx
-        force[i, 1] = fy
-        force[i, 2] = fz
-        torque[i, 0] = tx
-        torque[i, 1] = ty
-        torque[i, 2] = tz

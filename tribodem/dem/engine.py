@@ -1,8 +1,8 @@
 """``Simulation``: the step loop that wires the kernels, plus checkpoints and stability checks.
 
-One step: (re)build the neighbour list if needed -> pair contact forces -> gather ->
-wall contacts -> extra interactions (bonds, thermal, ... added as ``Interaction``
-objects) -> central-difference update -> walls move (servo) -> periodic wrap.
+One step: (re)build the neighbour list if needed -> pair contact forces -> extra
+interactions (bonds, thermal, ... added as ``Interaction`` objects) -> per particle:
+gather, wall contacts, central-difference update, periodic wrap -> walls move (servo).
 The engine knows nothing about brakes or fretting; applications compose it.
 """
 
@@ -16,19 +16,23 @@ from typing import Protocol
 import numpy as np
 
 from tribodem.dem import neighbors
-from tribodem.dem.contact import HIST, Material, gather, pair_forces, pair_table
+from tribodem.dem.contact import HIST, Material, pair_forces, pair_table
 from tribodem.dem.errors import SimulationUnstable, TimeStepError
-from tribodem.dem.integrate import central_difference, critical_step
-from tribodem.dem.space import Box, wrap_positions
+from tribodem.dem.integrate import BLOCK, advance, critical_step
+from tribodem.dem.space import Box
 from tribodem.dem.state import ParticleState
-from tribodem.dem.walls import PlaneWall, wall_forces, wall_totals
+from tribodem.dem.walls import PlaneWall, wall_arrays
 from tribodem.io.results import write_npz
 
 CHECKPOINT_VERSION = 1
 
 
 class Interaction(Protocol):
-    """An extra force contribution (bonds, thermal loads, ...): adds into sim.force/torque."""
+    """An extra force contribution (bonds, thermal loads, ...).
+
+    ``compute(sim)`` runs every step after the pair contacts and adds its forces and
+    moments into ``sim.ext_force`` / ``sim.ext_torque`` (zeroed before, N and N m).
+    """
 
     def compute(self, sim: Simulation) -> None: ...
 
@@ -82,9 +86,13 @@ class Simulation:
                                   box.periodic)
         self.hist = np.zeros((self.nl.n_pairs, HIST))
         self._alloc_pairs()
+        self.ext_force = np.zeros((n, 3))
+        self.ext_torque = np.zeros((n, 3))
         self.wall_hist = np.zeros((len(self.walls), n, HIST))
         self.wall_info = np.zeros((len(self.walls), n, 4))
-        self._fwall = np.zeros((n, 3))
+        nblocks = (n + BLOCK - 1) // BLOCK
+        self._wsum = np.zeros((nblocks, len(self.walls), 5))
+        self.drift = np.zeros(nblocks)
         self.dt_critical, self.dt_limit_by = critical_step(
             self.p.density, self.p.radius, self.p.mass, self.p.inertia, self.p.mat,
             self.nl.pair_i, self.nl.pair_j, self.pairtab, self.elin, self.materials, self.p.dim,
@@ -146,57 +154,68 @@ class Simulation:
 
     # ------------------------------------------------------------------ stepping
     def _maybe_rebuild(self) -> None:
-        drift = neighbors.max_drift.pick(self.p.n)(self.p.pos, self.nl.ref_pos, self.p.radius,
-                                    self.nl.ref_radius, self.box.length, self.box.periodic)
-        if drift <= 0.5 * self.skin:
+        if self.drift.max(initial=0.0) <= 0.5 * self.skin:
             return
         old, old_hist = self.nl, self.hist
         self.nl = neighbors.build(self.p.pos, self.p.radius, self.skin, self.box.lo,
                                   self.box.hi, self.box.periodic, old.builds)
         self.hist = np.zeros((self.nl.n_pairs, HIST))
-        neighbors.transfer_history.pick(self.p.n)(old.start, old.pair_j, old_hist, self.nl.start,
-                                   self.nl.pair_j, self.hist)
+        neighbors.transfer_history.pick(self.p.n)(old.start, old.pair_j, old_hist,
+                                                  self.nl.start, self.nl.pair_j, self.hist)
         self._alloc_pairs()
+        self.drift[:] = 0.0
 
-    def compute_forces(self) -> None:
-        """Contact, wall and extra forces for the current positions and velocities."""
+    def _pair_forces(self) -> None:
         p = self.p
-        pair_forces.pick(self.nl.n_pairs)(p.pos, p.vel, p.omega, p.radius, p.mass, p.inertia, p.mat,
-                    self.nl.pair_i, self.nl.pair_j, self.hist, self.pairtab, self.elin,
-                    self.box.length, self.box.periodic, p.dim, p.thickness, self.dt,
-                    self.fpair, self.tpair_i, self.tpair_j, self.pinfo)
-        gather.pick(p.n)(self.nl.start, self.nl.rev_start, self.nl.rev_pair, self.fpair,
-                         self.tpair_i, self.tpair_j, self.force, self.torque)
-        for w_id, w in enumerate(self.walls):
-            wall_forces.pick(p.n)(p.pos, p.vel, p.omega, p.radius, p.mass, p.inertia, p.mat,
-                        w.point, w.normal, w.velocity, w.material, self.wall_hist[w_id],
-                        self.pairtab,
-                        self.elin, p.dim, p.thickness, self.dt, self.force, self.torque,
-                        self._fwall, self.wall_info[w_id])
-            fx, fy, fz, w.contacts, w.stiffness = wall_totals(self._fwall, self.wall_info[w_id])
-            w.force = np.array([fx, fy, fz])
-            w.normal_force = -float(w.force @ w.normal)
-        for inter in self.interactions:
-            inter.compute(self)
+        pair_forces.pick(self.nl.n_pairs)(
+            p.pos, p.vel, p.omega, p.radius, p.mass, p.inertia, p.mat, self.nl.pair_i,
+            self.nl.pair_j, self.hist, self.pairtab, self.elin, self.box.length,
+            self.box.periodic, p.dim, p.thickness, self.dt, self.fpair, self.tpair_i,
+            self.tpair_j, self.pinfo)
+
+    def _advance(self) -> None:
+        p = self.p
+        wp, wn, wv, wm = wall_arrays(self.walls)
+        advance.pick(p.n)(
+            p.pos, p.vel, p.omega, p.radius, p.mass, p.inertia, p.mat, p.fixed, self.nl.start,
+            self.nl.rev_start, self.nl.rev_pair, self.fpair, self.tpair_i, self.tpair_j, wp,
+            wn, wv, wm, self.wall_hist, self.wall_info, self._wsum, self.pairtab, self.elin,
+            p.dim, p.thickness, self.dt, self.gravity, self.viscous_damping,
+            self.local_damping, self.ext_force, self.ext_torque, self.force, self.torque,
+            self.nl.ref_pos, self.nl.ref_radius, self.box.lo, self.box.length,
+            self.box.periodic, self.drift)
+        if self.walls:
+            tot = self._wsum.sum(axis=0)
+            for w_id, w in enumerate(self.walls):
+                w.force = tot[w_id, :3].copy()
+                w.normal_force = -float(w.force @ w.normal)
+                w.contacts = int(tot[w_id, 3])
+                w.stiffness = float(tot[w_id, 4])
 
     def step(self, n: int = 1) -> None:
-        """Advance ``n`` steps. Raises ``SimulationUnstable`` (recorders flushed) on blow-up."""
+        """Advance ``n`` steps. Raises ``SimulationUnstable`` (recorders flushed) on blow-up.
+
+        A step: neighbour list if needed -> pair contacts -> extra interactions (into
+        ``ext_force``/``ext_torque``) -> per particle: gather, walls, update, wrap ->
+        walls move (servo uses the wall force just measured).
+        """
         try:
             if self.step_count == 0 and self.time == 0.0:
                 self._sample(force=True)
             for _ in range(n):
                 self._maybe_rebuild()
-                self.compute_forces()
-                p = self.p
+                self._pair_forces()
+                if self.interactions:
+                    self.ext_force[:] = 0.0
+                    self.ext_torque[:] = 0.0
+                    for inter in self.interactions:
+                        inter.compute(self)
                 if self.track_energy:
+                    p = self.p
                     self._at_force_eval = (p.pos.copy(), p.vel.copy(), p.omega.copy())
-                central_difference.pick(p.n)(p.pos, p.vel, p.omega, self.force, self.torque, p.mass,
-                                   p.inertia, p.fixed, self.gravity, self.dt,
-                                   self.viscous_damping, self.local_damping, p.dim)
+                self._advance()
                 for w in self.walls:
                     w.update_motion(self.dt)
-                if self.box.periodic.any():
-                    wrap_positions.pick(p.n)(p.pos, self.box.lo, self.box.length, self.box.periodic)
                 self.step_count += 1
                 self.time += self.dt
                 if self.step_count % self.check_every == 0:
@@ -309,6 +328,7 @@ class Simulation:
             "nl_ref_pos": self.nl.ref_pos, "nl_ref_radius": self.nl.ref_radius,
             "hist": self.hist, "wall_hist": self.wall_hist, "wall_info": self.wall_info,
             "pinfo": self.pinfo, "force": self.force, "torque": self.torque,
+            "drift": self.drift, "ext_force": self.ext_force, "ext_torque": self.ext_torque,
         })
         for w_id, w in enumerate(self.walls):
             for k, v in w.state().items():
@@ -345,6 +365,9 @@ class Simulation:
             self.pinfo = z["pinfo"].copy()
             self.force = z["force"].copy()
             self.torque = z["torque"].copy()
+            self.drift = z["drift"].copy()
+            self.ext_force = z["ext_force"].copy()
+            self.ext_torque = z["ext_torque"].copy()
             for w_id, w in enumerate(self.walls):
                 w.set_state({k: z[f"w{w_id}_{k}"] for k in ("point", "velocity", "force",
                                                             "scalars")})

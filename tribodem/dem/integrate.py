@@ -1,5 +1,6 @@
 """Central-difference integrator with damping (seed 000 eqs 1-8) and time-step estimates.
 
+``advance`` is the per-particle half of a step (forces gathered, walls, update).
 Velocity form of eqs 4-8 (leapfrog): ``(m + eta dt/2) v+ = (m - eta dt/2) v- + F dt`` and
 ``x+ = x + v+ dt``, likewise for rotation with I and the moment M. ``eta = c m`` with
 ``c`` the global viscous damping rate (1/s) -- the seed's eta in eq 1 -- and the elastic
@@ -12,41 +13,120 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import prange
+from numba import njit, prange
 
 from tribodem.dem.contact import LINEAR, P_KRATIO, P_LAW
 from tribodem.dem.jit import kernel
+from tribodem.dem.space import min_image
+from tribodem.dem.walls import wall_contact
+
+BLOCK = 256  # particles per block: fixed, so block sums do not depend on the thread count
 
 
-@kernel
-def central_difference(pos, vel, omega, force, torque, mass, inertia, fixed, gravity, dt,
-                       viscous, local, dim):
-    """One step for all particles (in place). Fixed DOFs keep their velocity."""
+@njit(cache=True, inline="always")
+def _update(pos, vel, omega, i, f, t, m, inertia, fixed, a, b, local, dt):
+    """Central-difference update of particle i for force f and moment t (seed 000 eqs 4, 7)."""
+    for k in range(3):
+        if fixed & (1 << k):
+            continue
+        fk = f[k]
+        v = vel[i, k]
+        if local > 0.0 and v != 0.0:
+            fk -= local * abs(fk) * (1.0 if v > 0.0 else -1.0)
+        vel[i, k] = a * v + b * fk / m
+    for k in range(3):
+        if fixed & (1 << (k + 3)):
+            continue
+        tk = t[k]
+        w = omega[i, k]
+        if local > 0.0 and w != 0.0:
+            tk -= local * abs(tk) * (1.0 if w > 0.0 else -1.0)
+        omega[i, k] = a * w + b * tk / inertia
+    for k in range(3):
+        pos[i, k] += vel[i, k] * dt
+
+
+@kernel(chunk=2)
+def advance(pos, vel, omega, radius, mass, inertia, mat, fixed, start, rev_start, rev_pair,
+            fpair, tpair_i, tpair_j, wpoint, wnormal, wvel, wmat, whist, winfo, wsum, pairtab,
+            elin, dim, thickness, dt, gravity, viscous, local, ext_force, ext_torque,
+            force, torque, ref_pos, ref_radius, lo, length, periodic, drift):
+    """One step for every particle: gather pair forces, wall contacts, external forces,
+    gravity, then the central-difference update with damping and the periodic wrap.
+
+    Writes the total force/torque (``force``, ``torque``), per-block wall sums
+    ``wsum[block, wall] = (Fx, Fy, Fz, touching, sum kn)`` and per-block ``drift`` (largest
+    move plus growth since the last neighbour build, m). Blocks of ``BLOCK`` particles are
+    summed in order, so the results are the same on any number of threads.
+    """
     n = pos.shape[0]
+    nw = wpoint.shape[0]
+    nblocks = (n + BLOCK - 1) // BLOCK
     h = 0.5 * viscous * dt
     a = (1.0 - h) / (1.0 + h)
     b = dt / (1.0 + h)
-    for i in prange(n):
-        m = mass[i]
-        fx = fixed[i]
-        for k in range(3):
-            if fx & (1 << k):
-                continue
-            f = force[i, k] + m * gravity[k]
-            v = vel[i, k]
-            if local > 0.0 and v != 0.0:
-                f -= local * abs(f) * (1.0 if v > 0.0 else -1.0)
-            vel[i, k] = a * v + b * f / m
-        for k in range(3):
-            if fx & (1 << (k + 3)):
-                continue
-            t = torque[i, k]
-            w = omega[i, k]
-            if local > 0.0 and w != 0.0:
-                t -= local * abs(t) * (1.0 if w > 0.0 else -1.0)
-            omega[i, k] = a * w + b * t / inertia[i]
-        for k in range(3):
-            pos[i, k] += vel[i, k] * dt
+    for blk in prange(nblocks):
+        for w in range(nw):
+            for k in range(5):
+                wsum[blk, w, k] = 0.0
+        dmax = 0.0
+        f = np.empty(3)
+        t = np.empty(3)
+        for i in range(blk * BLOCK, min(n, (blk + 1) * BLOCK)):
+            for k in range(3):
+                f[k] = ext_force[i, k] + mass[i] * gravity[k]
+                t[k] = ext_torque[i, k]
+            for p in range(start[i], start[i + 1]):
+                for k in range(3):
+                    f[k] -= fpair[p, k]
+                    t[k] += tpair_i[p, k]
+            for q in range(rev_start[i], rev_start[i + 1]):
+                p = rev_pair[q]
+                for k in range(3):
+                    f[k] += fpair[p, k]
+                    t[k] += tpair_j[p, k]
+            for w in range(nw):
+                hit, f0, f1, f2, t0, t1, t2, delta, fn, energy, kn = wall_contact(
+                    pos[i, 0], pos[i, 1], pos[i, 2], vel[i, 0], vel[i, 1], vel[i, 2],
+                    omega[i, 0], omega[i, 1], omega[i, 2], radius[i], mass[i], inertia[i],
+                    mat[i], wpoint[w], wnormal[w], wvel[w], wmat[w], whist[w, i], pairtab,
+                    elin, dim, thickness, dt)
+                winfo[w, i, 0] = delta
+                winfo[w, i, 1] = fn
+                winfo[w, i, 2] = energy
+                winfo[w, i, 3] = kn
+                if hit:
+                    f[0] -= f0
+                    f[1] -= f1
+                    f[2] -= f2
+                    t[0] += t0
+                    t[1] += t1
+                    t[2] += t2
+                    wsum[blk, w, 0] += f0
+                    wsum[blk, w, 1] += f1
+                    wsum[blk, w, 2] += f2
+                    wsum[blk, w, 3] += 1.0
+                    wsum[blk, w, 4] += kn
+            for k in range(3):
+                force[i, k] = f[k] - mass[i] * gravity[k]
+                torque[i, k] = t[k]
+            _update(pos, vel, omega, i, f, t, mass[i], inertia[i], fixed[i], a, b, local, dt)
+            dd = 0.0
+            for k in range(3):
+                if periodic[k]:
+                    x = pos[i, k] - lo[k]
+                    if x < 0.0 or x >= length[k]:
+                        x -= length[k] * np.floor(x / length[k])
+                        if x >= length[k]:
+                            x -= length[k]
+                        pos[i, k] = lo[k] + x
+                dk = min_image(pos[i, k] - ref_pos[i, k], length[k], periodic[k])
+                dd += dk * dk
+            g = radius[i] - ref_radius[i]
+            dd = np.sqrt(dd) + (g if g > 0.0 else 0.0)
+            if dd > dmax:
+                dmax = dd
+        drift[blk] = dmax
 
 
 def rayleigh_step(radius: float, density: float, shear_modulus: float, poisson: float) -> float:

@@ -238,17 +238,3 @@ def transfer_history(old_start, old_j, old_hist, new_start, new_j, new_hist):
             if lo < b0 and old_j[lo] == j:
                 for k in range(new_hist.shape[1]):
                     new_hist[p, k] = old_hist[lo, k]
-
-
-@kernel
-def max_drift(pos, ref_pos, radius, ref_radius, length, periodic):
-    """Largest displacement (minimum image) plus radius growth since the last build (m)."""
-    n = pos.shape[0]
-    out = np.zeros(n)
-    for i in prange(n):
-        dx = min_image(pos[i, 0] - ref_pos[i, 0], length[0], periodic[0])
-        dy = min_image(pos[i, 1] - ref_pos[i, 1], length[1], periodic[1])
-        dz = min_image(pos[i, 2] - ref_pos[i, 2], length[2], periodic[2])
-        g = radius[i] - ref_radius[i]
-        out[i] = np.sqrt(dx * dx + dy * dy + dz * dz) + (g if g > 0 else 0.0)
-    return out.max() if n else 0.0

@@ -5,9 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-from numba import njit, prange
-
-from tribodem.dem.jit import kernel
+from numba import njit
 
 
 @dataclass
@@ -42,19 +40,3 @@ def min_image(d: float, length: float, periodic: bool) -> float:
     if periodic:
         return d - length * np.rint(d / length)
     return d
-
-
-@kernel
-def wrap_positions(pos: np.ndarray, lo: np.ndarray, length: np.ndarray,
-                   periodic: np.ndarray) -> None:
-    """Map positions on periodic axes back into [lo, lo + L) (in place)."""
-    n = pos.shape[0]
-    for i in prange(n):
-        for k in range(3):
-            if periodic[k]:
-                x = pos[i, k] - lo[k]
-                if x < 0.0 or x >= length[k]:
-                    x -= length[k] * np.floor(x / length[k])
-                    if x >= length[k]:
-                        x -= length[k]
-                    pos[i, k] = lo[k] + x

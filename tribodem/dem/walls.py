@@ -17,10 +17,9 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
 from tribodem.dem.contact import P_LAW, contact_response
-from tribodem.dem.jit import kernel
 
 WALL_MODES = ("fixed", "velocity", "servo", "boundary")
 
@@ -98,77 +97,49 @@ class PlaneWall:
         self.contacts = int(c)
 
 
-@kernel
-def wall_forces(pos, vel, omega, radius, mass, inertia, mat, point, normal, wvel, wmat,
-                hist, pairtab, elin, dim, thickness, dt, force, torque, fwall, info):
-    """Contacts of every particle with one plane wall; adds to force/torque.
+@njit(cache=True, inline="always")
+def wall_contact(x0, x1, x2, v0, v1, v2, w0, w1, w2, r, m, inertia, mat_i, point, normal, wvel,
+                 wmat, hist, pairtab, elin, dim, thickness, dt):
+    """Contact of one particle with one plane wall.
 
-    hist[i]: shear spring of particle i on this wall. fwall[i]: force on the wall from
-    particle i. info[i] = (overlap, normal force, energy, kn).
+    Returns (touching, force on the wall (3, N), torque on the particle (3, N m),
+    overlap m, normal force N, energy J, kn N/m); the particle gets minus the force.
+    ``hist`` (shear spring of this particle on this wall) is updated in place.
     """
-    n = pos.shape[0]
-    for i in prange(n):
-        d = ((pos[i, 0] - point[0]) * normal[0] + (pos[i, 1] - point[1]) * normal[1]
-             + (pos[i, 2] - point[2]) * normal[2])
-        r = radius[i]
-        delta = r - d
-        if delta <= 0.0:
-            for k in range(3):
-                hist[i, k] = 0.0
-                fwall[i, k] = 0.0
-            info[i, 0] = delta
-            info[i, 1] = 0.0
-            info[i, 2] = 0.0
-            info[i, 3] = 0.0
-            continue
-        # unit normal from the particle (body 1) to the wall (body 2)
-        n0 = -normal[0]
-        n1 = -normal[1]
-        n2 = -normal[2]
-        arm = d
-        w0, w1, w2 = omega[i, 0], omega[i, 1], omega[i, 2]
-        v0 = wvel[0] - (vel[i, 0] + arm * (w1 * n2 - w2 * n1))
-        v1 = wvel[1] - (vel[i, 1] + arm * (w2 * n0 - w0 * n2))
-        v2 = wvel[2] - (vel[i, 2] + arm * (w0 * n1 - w1 * n0))
-        area = 2.0 * r * thickness if dim == 2 else np.pi * r * r
-        # PFC ball-facet: L = r; modulus = harmonic mean of particle and wall moduli
-        lin_k = area * 2.0 / (1.0 / elin[mat[i]] + 1.0 / elin[wmat]) / r
-        prop = pairtab[mat[i], wmat]
-        f0, f1, f2, r0, r1, r2, fn, energy, kn = contact_response(
-            int(prop[P_LAW]), prop, n0, n1, n2, delta, v0, v1, v2, w0, w1, w2, r, mass[i],
-            inertia[i], lin_k, hist[i], dt)
-        # force on particle = -F; torque on particle = (arm n) x (-F) + rolling
-        force[i, 0] -= f0
-        force[i, 1] -= f1
-        force[i, 2] -= f2
-        torque[i, 0] += -arm * (n1 * f2 - n2 * f1) + r0
-        torque[i, 1] += -arm * (n2 * f0 - n0 * f2) + r1
-        torque[i, 2] += -arm * (n0 * f1 - n1 * f0) + r2
-        fwall[i, 0] = f0
-        fwall[i, 1] = f1
-        fwall[i, 2] = f2
-        info[i, 0] = delta
-        info[i, 1] = fn
-        info[i, 2] = energy
-        info[i, 3] = kn
+    d = (x0 - point[0]) * normal[0] + (x1 - point[1]) * normal[1] + (x2 - point[2]) * normal[2]
+    delta = r - d
+    if delta <= 0.0:
+        hist[0] = 0.0
+        hist[1] = 0.0
+        hist[2] = 0.0
+        return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, delta, 0.0, 0.0, 0.0
+    # unit normal from the particle (body 1) to the wall (body 2); contact point on the plane
+    n0 = -normal[0]
+    n1 = -normal[1]
+    n2 = -normal[2]
+    arm = d
+    u0 = wvel[0] - (v0 + arm * (w1 * n2 - w2 * n1))
+    u1 = wvel[1] - (v1 + arm * (w2 * n0 - w0 * n2))
+    u2 = wvel[2] - (v2 + arm * (w0 * n1 - w1 * n0))
+    area = 2.0 * r * thickness if dim == 2 else np.pi * r * r
+    # PFC ball-facet: L = r; modulus = harmonic mean of particle and wall moduli
+    lin_k = area * 2.0 / (1.0 / elin[mat_i] + 1.0 / elin[wmat]) / r
+    prop = pairtab[mat_i, wmat]
+    f0, f1, f2, r0, r1, r2, fn, energy, kn = contact_response(
+        int(prop[P_LAW]), prop, n0, n1, n2, delta, u0, u1, u2, w0, w1, w2, r, m, inertia,
+        lin_k, hist, dt)
+    t0 = -arm * (n1 * f2 - n2 * f1) + r0
+    t1 = -arm * (n2 * f0 - n0 * f2) + r1
+    t2 = -arm * (n0 * f1 - n1 * f0) + r2
+    return True, f0, f1, f2, t0, t1, t2, delta, fn, energy, kn
 
 
-@njit(cache=True)
-def wall_totals(fwall, info):
-    """Total force on the wall (N), number of touching particles, sum of their kn (N/m).
-
-    Serial and in particle order, so the servo sees the same value on any thread count.
-    """
-    fx = 0.0
-    fy = 0.0
-    fz = 0.0
-    count = 0
-    ksum = 0.0
-    for i in range(fwall.shape[0]):
-        if info[i, 1] != 0.0:
-            fx += fwall[i, 0]
-            fy += fwall[i, 1]
-            fz += fwall[i, 2]
-            count += 1
-            ksum += info[i, 3]
-    return fx, fy, fz, count, ksum
+def wall_arrays(walls: list[PlaneWall]) -> tuple[np.ndarray, ...]:
+    """Point, normal, velocity (nw, 3) and material (nw,) arrays of the walls for kernels."""
+    nw = len(walls)
+    if nw == 0:
+        z = np.zeros((0, 3))
+        return z, z.copy(), z.copy(), np.zeros(0, dtype=np.int64)
+    return (np.array([w.point for w in walls]), np.array([w.normal for w in walls]),
+            np.array([w.velocity for w in walls]),
+            np.array([w.material for w in walls], dtype=np.int64))
