@@ -166,17 +166,18 @@ def set_pair(tab: np.ndarray, a: int, b: int, ma: Material, mb: Material, **over
 
 
 @njit(cache=True, inline="always")
-def law_normal(law, prop, delta, vn, rstar, mstar, _area, lin_k):
+def law_normal(law, prop, delta, vn, rstar, mstar, lin_k):
     """Normal force magnitude (N, + = repulsive), tangential stiffness (N/m), tangential
     damping coefficient (N s/m), normal stiffness (N/m) and stored energy (J)."""
     if law == HERTZ:
         estar = prop[P_ESTAR]
-        sq = np.sqrt(rstar * delta)
+        sq = np.sqrt(rstar * delta)  # contact radius a = sqrt(R* d)
         sn = 2.0 * estar * sq
         st = 8.0 * prop[P_GSTAR] * sq
-        fe = (4.0 / 3.0) * estar * np.sqrt(rstar) * delta * np.sqrt(delta)
-        fn = fe - prop[P_GAMMA] * np.sqrt(sn * mstar) * vn
-        ct = prop[P_GAMMA] * np.sqrt(st * mstar)
+        fe = (4.0 / 3.0) * estar * delta * sq
+        gm = prop[P_GAMMA] * np.sqrt(sq * mstar)  # gamma sqrt(S m*) = gm sqrt(S / a)
+        fn = fe - gm * np.sqrt(2.0 * estar) * vn
+        ct = gm * np.sqrt(8.0 * prop[P_GSTAR])
         energy = 0.4 * fe * delta
         return fn, st, ct, sn, energy
     kn = lin_k
@@ -198,20 +199,21 @@ def contact_response(law, prop, n0, n1, n2, delta, v0, v1, v2, w0, w1, w2, rstar
     allocation in the hot loop.
     """
     vn = v0 * n0 + v1 * n1 + v2 * n2
-    fn, kt, ct, kn, energy = law_normal(law, prop, delta, vn, rstar, mstar, 0.0, lin_k)
+    fn, kt, ct, kn, energy = law_normal(law, prop, delta, vn, rstar, mstar, lin_k)
     # shear spring: rotate into the current tangent plane (keep its length), add slip
     h0, h1, h2 = hist[0], hist[1], hist[2]
     hn = h0 * n0 + h1 * n1 + h2 * n2
-    len0 = np.sqrt(h0 * h0 + h1 * h1 + h2 * h2)
-    h0 -= hn * n0
-    h1 -= hn * n1
-    h2 -= hn * n2
-    len1 = np.sqrt(h0 * h0 + h1 * h1 + h2 * h2)
-    if len1 > 0.0:
-        sc = len0 / len1
-        h0 *= sc
-        h1 *= sc
-        h2 *= sc
+    if hn != 0.0:
+        len0 = h0 * h0 + h1 * h1 + h2 * h2
+        h0 -= hn * n0
+        h1 -= hn * n1
+        h2 -= hn * n2
+        len1 = h0 * h0 + h1 * h1 + h2 * h2
+        if len1 > 0.0:
+            sc = np.sqrt(len0 / len1)
+            h0 *= sc
+            h1 *= sc
+            h2 *= sc
     vt0 = v0 - vn * n0
     vt1 = v1 - vn * n1
     vt2 = v2 - vn * n2
@@ -221,10 +223,10 @@ def contact_response(law, prop, n0, n1, n2, delta, v0, v1, v2, w0, w1, w2, rstar
     ft0 = -kt * h0 - ct * vt0
     ft1 = -kt * h1 - ct * vt1
     ft2 = -kt * h2 - ct * vt2
-    ftm = np.sqrt(ft0 * ft0 + ft1 * ft1 + ft2 * ft2)
+    ftm2 = ft0 * ft0 + ft1 * ft1 + ft2 * ft2
     fmax = prop[P_MU] * (fn if fn > 0.0 else 0.0)
-    if ftm > fmax:
-        sc = fmax / ftm if ftm > 0.0 else 0.0
+    if ftm2 > fmax * fmax:
+        sc = fmax / np.sqrt(ftm2)
         ft0 *= sc
         ft1 *= sc
         ft2 *= sc
@@ -268,7 +270,8 @@ def pair_forces(pos, vel, omega, radius, mass, inertia, mat, pair_i, pair_j, his
     """Forces of all listed pairs (prange over pairs; no shared writes).
 
     fpair[p]: force on j (i gets minus it); tpair_i/tpair_j: torques (N m);
-    pinfo[p] = (overlap m, normal force N, energy J, kn N/m).
+    pinfo[p] = (overlap m, normal force N, energy J, kn N/m). A pair found apart is
+    cleared only if it was in contact (pinfo[p, 0] > 0) at the previous evaluation.
     """
     m = pair_i.shape[0]
     for p in prange(m):
@@ -282,19 +285,21 @@ def pair_forces(pos, vel, omega, radius, mass, inertia, mat, pair_i, pair_j, his
         rj = radius[j]
         delta = ri + rj - dist
         if delta <= 0.0 or dist == 0.0:
-            for k in range(3):
-                hist[p, k] = 0.0
-                fpair[p, k] = 0.0
-                tpair_i[p, k] = 0.0
-                tpair_j[p, k] = 0.0
+            if pinfo[p, 0] > 0.0:  # the contact just ended: clear it once
+                for k in range(3):
+                    hist[p, k] = 0.0
+                    fpair[p, k] = 0.0
+                    tpair_i[p, k] = 0.0
+                    tpair_j[p, k] = 0.0
+                pinfo[p, 1] = 0.0
+                pinfo[p, 2] = 0.0
+                pinfo[p, 3] = 0.0
             pinfo[p, 0] = delta
-            pinfo[p, 1] = 0.0
-            pinfo[p, 2] = 0.0
-            pinfo[p, 3] = 0.0
             continue
-        n0 = d0 / dist
-        n1 = d1 / dist
-        n2 = d2 / dist
+        inv = 1.0 / dist
+        n0 = d0 * inv
+        n1 = d1 * inv
+        n2 = d2 * inv
         ai = ri - 0.5 * delta
         aj = rj - 0.5 * delta
         # v_c = v + omega x arm: body i arm +ai n, body j arm -aj n
@@ -306,12 +311,15 @@ def pair_forces(pos, vel, omega, radius, mass, inertia, mat, pair_i, pair_j, his
         rstar = ri * rj / (ri + rj)
         mstar = mass[i] * mass[j] / (mass[i] + mass[j])
         istar = inertia[i] * inertia[j] / (inertia[i] + inertia[j])
-        rmin = ri if ri < rj else rj
-        area = 2.0 * rmin * thickness if dim == 2 else np.pi * rmin * rmin
-        lin_k = area / (ri / elin[mat[i]] + rj / elin[mat[j]])
         prop = pairtab[mat[i], mat[j]]
+        law = int(prop[P_LAW])
+        lin_k = 0.0
+        if law == LINEAR:
+            rmin = ri if ri < rj else rj
+            area = 2.0 * rmin * thickness if dim == 2 else np.pi * rmin * rmin
+            lin_k = area / (ri / elin[mat[i]] + rj / elin[mat[j]])
         f0, f1, f2, r0, r1, r2, fn, energy, kn = contact_response(
-            int(prop[P_LAW]), prop, n0, n1, n2, delta, v0, v1, v2, wi0 - wj0, wi1 - wj1,
+            law, prop, n0, n1, n2, delta, v0, v1, v2, wi0 - wj0, wi1 - wj1,
             wi2 - wj2, rstar, mstar, istar, lin_k, hist[p], dt)
         fpair[p, 0] = f0
         fpair[p, 1] = f1

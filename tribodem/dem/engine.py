@@ -141,6 +141,7 @@ class Simulation:
         self.tpair_i = np.zeros((m, 3))
         self.tpair_j = np.zeros((m, 3))
         self.pinfo = np.zeros((m, 4))
+        self.pinfo[:, 0] = 1.0  # unknown yet: the first evaluation clears what is apart
 
     def add_interaction(self, inter: Interaction) -> None:
         """Add an extra force contribution, evaluated every step after contacts."""

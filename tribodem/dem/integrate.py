@@ -86,6 +86,11 @@ def advance(pos, vel, omega, radius, mass, inertia, mat, fixed, start, rev_start
                     f[k] += fpair[p, k]
                     t[k] += tpair_j[p, k]
             for w in range(nw):
+                gap = ((pos[i, 0] - wpoint[w, 0]) * wnormal[w, 0]
+                       + (pos[i, 1] - wpoint[w, 1]) * wnormal[w, 1]
+                       + (pos[i, 2] - wpoint[w, 2]) * wnormal[w, 2]) - radius[i]
+                if gap >= 0.0 and winfo[w, i, 0] <= 0.0:
+                    continue  # apart now and before: nothing to update
                 hit, f0, f1, f2, t0, t1, t2, delta, fn, energy, kn = wall_contact(
                     pos[i, 0], pos[i, 1], pos[i, 2], vel[i, 0], vel[i, 1], vel[i, 2],
                     omega[i, 0], omega[i, 1], omega[i, 2], radius[i], mass[i], inertia[i],
