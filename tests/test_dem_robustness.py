@@ -80,3 +80,28 @@ def test_instability_stops_and_keeps_outputs(tmp_path) -> None:
     assert data.size >= 2 and data["step"][-1] <= sim.step_count
     assert any((tmp_path / "vtk").glob("particles_*.vtu"))
     assert (tmp_path / "vtk" / "particles.pvd").exists()
+
+
+def test_same_result_on_one_and_two_threads() -> None:
+    """Pair forces per pair, particle sums per fixed block: thread count changes nothing."""
+    import numba
+
+    from tribodem.dem.bench import simulation_from_case
+    from tribodem.dem.bench_cases import settle3d_case
+    from tribodem.dem.jit import PARALLEL_MIN
+
+    if numba.config.NUMBA_NUM_THREADS < 2:
+        pytest.skip("needs 2 threads")
+    finals = []
+    before = numba.get_num_threads()
+    try:
+        for threads in (1, 2):
+            numba.set_num_threads(threads)
+            sim = simulation_from_case(settle3d_case(n=PARALLEL_MIN + 1000, steps=300))
+            sim.step(300)
+            finals.append((sim.p.pos.copy(), sim.p.vel.copy(), sim.walls[0].normal_force))
+    finally:
+        numba.set_num_threads(before)
+    assert np.array_equal(finals[0][0], finals[1][0])
+    assert np.array_equal(finals[0][1], finals[1][1])
+    assert finals[0][2] == finals[1][2] and finals[0][2] > 0
