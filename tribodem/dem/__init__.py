@@ -4,22 +4,30 @@ Rooms, one concept each (JAX-MD style: plain kernels over arrays, small classes 
 wire them): ``state`` (particle arrays), ``space`` (box, periodic axes),
 ``neighbors`` (cell-list Verlet lists), ``contact`` (contact laws), ``walls`` (planes,
 servo walls), ``integrate`` (central difference with damping, time-step estimates),
-``engine`` (``Simulation``: the step loop, checkpoints), ``recorders`` (CSV, VTK).
+``engine`` (``Simulation``: the step loop, checkpoints), ``recorders`` (CSV, VTK),
+``bonds`` (linear parallel bonds, breakage log), ``thermal`` (temperature, expansion,
+conduction through intact bonds).
 """
 
+from tribodem.dem.bonds import BondBreak, ParallelBonds, install_bonds_by_gap
 from tribodem.dem.contact import Material
 from tribodem.dem.engine import Simulation
 from tribodem.dem.errors import SimulationUnstable, TimeStepError
 from tribodem.dem.space import Box
 from tribodem.dem.state import ParticleState
+from tribodem.dem.thermal import Thermal
 from tribodem.dem.walls import PlaneWall
 
 __all__ = [
+    "BondBreak",
     "Box",
     "Material",
+    "ParallelBonds",
     "ParticleState",
     "PlaneWall",
     "Simulation",
     "SimulationUnstable",
+    "Thermal",
     "TimeStepError",
+    "install_bonds_by_gap",
 ]

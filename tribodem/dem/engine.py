@@ -97,6 +97,9 @@ class Simulation:
             self.p.density, self.p.radius, self.p.mass, self.p.inertia, self.p.mat,
             self.nl.pair_i, self.nl.pair_j, self.pairtab, self.elin, self.materials, self.p.dim,
             self.p.thickness, self.p.pos, self.walls, self.skin)
+        self.force_dt = bool(force_dt)
+        self._auto_dt = dt is None
+        self._dt_safety = float(dt_safety)
         if dt is None:
             self.dt = dt_safety * self.dt_critical
         else:
@@ -144,7 +147,24 @@ class Simulation:
         self.pinfo[:, 0] = 1.0  # unknown yet: the first evaluation clears what is apart
 
     def add_interaction(self, inter: Interaction) -> None:
-        """Add an extra force contribution, evaluated every step after contacts."""
+        """Add an extra force contribution, evaluated every step after contacts.
+
+        An interaction with ``critical_step(sim)`` (bonds) lowers the critical step: an
+        automatic dt follows it; a user dt above it is refused unless ``force_dt``.
+        """
+        crit = getattr(inter, "critical_step", None)
+        if crit is not None:
+            dt_c = float(crit(self))
+            if dt_c < self.dt_critical:
+                self.dt_critical = dt_c
+                self.dt_limit_by = f"{type(inter).__name__} stiffness sqrt(m/k)"
+                if self._auto_dt:
+                    self.dt = self._dt_safety * dt_c
+                elif self.dt > dt_c and not self.force_dt:
+                    raise TimeStepError(
+                        f"dt = {self.dt:.6g} s is above the critical time step {dt_c:.6g} s "
+                        f"limited by {self.dt_limit_by}; use dt <= {dt_c:.6g} s "
+                        "(or force_dt=True)")
         self.interactions.append(inter)
 
     def add_recorder(self, recorder: Recorder, every: int) -> None:
@@ -334,6 +354,10 @@ class Simulation:
         for w_id, w in enumerate(self.walls):
             for k, v in w.state().items():
                 arrays[f"w{w_id}_{k}"] = v
+        for x_id, inter in enumerate(self.interactions):  # bonds, thermal, ...
+            if hasattr(inter, "state"):
+                for k, v in inter.state().items():
+                    arrays[f"x{x_id}_{k}"] = v
         meta = {"version": CHECKPOINT_VERSION, "step": self.step_count, "time": self.time,
                 "dt": self.dt, "nl_builds": self.nl.builds, "skin": self.skin,
                 "n": self.p.n}
@@ -372,6 +396,10 @@ class Simulation:
             for w_id, w in enumerate(self.walls):
                 w.set_state({k: z[f"w{w_id}_{k}"] for k in ("point", "velocity", "force",
                                                             "scalars")})
+            for x_id, inter in enumerate(self.interactions):
+                if hasattr(inter, "set_state"):
+                    pre = f"x{x_id}_"
+                    inter.set_state({k[len(pre):]: z[k] for k in z.files if k.startswith(pre)})
             self.step_count = int(meta["step"])
             self.time = float(z["time_exact"][0])
             self.dt = float(meta["dt"])

@@ -1,0 +1,482 @@
+"""Linear parallel bond (Potyondy & Cundall 2004; PFC "linearpbond"; seed 000 eqs 9-11).
+
+A bond is a finite elastic cylinder (2D: a slab of thickness t) of radius
+``Rb = lambda min(r_i, r_j)`` glued between two particles at the contact point
+``x_c = x_i + (r_i + g/2) n`` (g the surface gap, n the unit normal from i to j).
+Section: area ``A`` (2D ``2 Rb t``, 3D ``pi Rb^2``), moment of inertia ``I`` (2D
+``2/3 t Rb^3``, 3D ``pi Rb^4/4``), polar moment ``J`` (3D ``pi Rb^4/2``). Stiffness per
+area ``kn = E_bond / (r_i + r_j)`` (Pa/m), ``ks = kn / kratio``.
+
+Incremental update each step (seed 000 eqs 9-10; forces and moments start at zero when
+the bond is installed): with ``v_c`` the velocity of j minus i at the contact point and
+``dtheta = (omega_j - omega_i) dt``,
+
+- ``Fn += -kn A (v_c . n) dt``            (normal force, **+ = compression**)
+- ``Fs += -ks A v_c,t dt``                 (shear force vector on j)
+- ``Mb += -kn I dtheta_b``                 (bending moment on j, dtheta_b = tangential part)
+- ``Mt += -ks J (dtheta . n)``             (3D twisting moment on j, about n)
+
+Before the increments the stored shear force and bending moment are rotated with the
+normal (rigid rotation from the old to the new normal, then about the normal by the mean
+spin), as PFC does. Force on j: ``Fn n + Fs``; i gets the opposite; moments on j:
+``Mb + Mt n`` plus ``(x_c - x_j) x F_j``.
+
+Maximum stresses (seed 000 eq 11 as in Potyondy & Cundall 2004, tension positive):
+``sigma = -Fn/A + |Mb| Rb/I``, ``tau = |Fs|/A + |Mt| Rb/J`` (2D: no twist). The bond breaks
+in tension when ``sigma >= sigma_t`` (checked first), in shear when
+``tau >= c - sigma_n tan(phi)`` with ``sigma_n = -Fn/A``. A broken bond carries nothing
+from then on (the contact law still acts if the particles overlap); every break is logged.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+from numba import njit, prange
+
+from tribodem.dem import neighbors
+from tribodem.dem.jit import kernel
+from tribodem.dem.space import min_image
+
+if TYPE_CHECKING:
+    from tribodem.dem.engine import Simulation
+
+INTACT, TENSILE, SHEAR = 0, 1, 2
+MODES = {"tensile": TENSILE, "shear": SHEAR}
+MODE_NAMES = {TENSILE: "tensile", SHEAR: "shear"}
+# columns of the per-bond break record written by the kernel
+B_X, B_Y, B_Z, B_FN, B_FS, B_MB, B_MT, B_SIGMA, B_TAU = range(9)
+N_BREAK = 9
+
+
+@dataclass(frozen=True)
+class BondBreak:
+    """One bond break: when, where (bond centre, m), how, which particles, and the load
+    carried at the break (N, N m, Pa; ``fn`` + = compression)."""
+
+    time: float
+    step: int
+    position: tuple[float, float, float]
+    mode: str
+    i: int
+    j: int
+    fn: float
+    fs: float
+    mb: float
+    mt: float
+    sigma: float
+    tau: float
+
+
+@njit(cache=True, inline="always")
+def _rotate(arr, b, c, k0, k1, k2, cw, sw, ws, n0, n1, n2):
+    """Rotate row b of arr with the contact: from the old normal o to the new n
+    (Rodrigues with k = o x n, c = o . n), then about n by the mean spin angle ws."""
+    v0, v1, v2 = arr[b, 0], arr[b, 1], arr[b, 2]
+    r0, r1, r2 = v0, v1, v2
+    if c > -1.0:
+        kv = (k0 * v0 + k1 * v1 + k2 * v2) / (1.0 + c)
+        r0 = c * v0 + (k1 * v2 - k2 * v1) + kv * k0
+        r1 = c * v1 + (k2 * v0 - k0 * v2) + kv * k1
+        r2 = c * v2 + (k0 * v1 - k1 * v0) + kv * k2
+    if ws != 0.0:
+        x0 = cw * r0 + sw * (n1 * r2 - n2 * r1)
+        x1 = cw * r1 + sw * (n2 * r0 - n0 * r2)
+        x2 = cw * r2 + sw * (n0 * r1 - n1 * r0)
+        r0, r1, r2 = x0, x1, x2
+    rn = r0 * n0 + r1 * n1 + r2 * n2  # round-off only: keep it tangential
+    arr[b, 0] = r0 - rn * n0
+    arr[b, 1] = r1 - rn * n1
+    arr[b, 2] = r2 - rn * n2
+
+
+@kernel(chunk=256)
+def bond_forces(pos, vel, omega, radius, bi, bj, rb, area, ib, jb, kn, ks, tens, coh, tanphi,
+                fn, fs, mb, mt, nrm, mode, newly, brk, fbond, tbi, tbj, dim, dt, length,
+                periodic):
+    """Update every intact bond (prange over bonds; each writes only its own rows).
+
+    fbond[b]: force on j (i gets minus it); tbi/tbj: moments on i and j (N m). A bond that
+    breaks this step gets ``mode`` (1 tensile, 2 shear), ``newly = 1``, its load in
+    ``brk`` and zero force. Returns the number of new breaks.
+    """
+    nb = bi.shape[0]
+    nnew = 0
+    for b in prange(nb):
+        if mode[b] != INTACT:
+            continue
+        i = bi[b]
+        j = bj[b]
+        d0 = min_image(pos[j, 0] - pos[i, 0], length[0], periodic[0])
+        d1 = min_image(pos[j, 1] - pos[i, 1], length[1], periodic[1])
+        d2 = min_image(pos[j, 2] - pos[i, 2], length[2], periodic[2])
+        dist = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+        inv = 1.0 / dist
+        n0 = d0 * inv
+        n1 = d1 * inv
+        n2 = d2 * inv
+        # rigid rotation of the stored shear force and bending moment: old -> new normal
+        o0, o1, o2 = nrm[b, 0], nrm[b, 1], nrm[b, 2]
+        c = o0 * n0 + o1 * n1 + o2 * n2
+        k0 = o1 * n2 - o2 * n1
+        k1 = o2 * n0 - o0 * n2
+        k2 = o0 * n1 - o1 * n0
+        # mean spin about the normal (3D; zero in 2D)
+        ws = 0.5 * ((omega[i, 0] + omega[j, 0]) * n0 + (omega[i, 1] + omega[j, 1]) * n1
+                    + (omega[i, 2] + omega[j, 2]) * n2) * dt
+        cw = np.cos(ws)
+        sw = np.sin(ws)
+        _rotate(fs, b, c, k0, k1, k2, cw, sw, ws, n0, n1, n2)
+        _rotate(mb, b, c, k0, k1, k2, cw, sw, ws, n0, n1, n2)
+        nrm[b, 0] = n0
+        nrm[b, 1] = n1
+        nrm[b, 2] = n2
+        # contact point arms: i -> x_c = a_i n, j -> x_c = -a_j n
+        ai = radius[i] + 0.5 * (dist - radius[i] - radius[j])
+        aj = dist - ai
+        wi0, wi1, wi2 = omega[i, 0], omega[i, 1], omega[i, 2]
+        wj0, wj1, wj2 = omega[j, 0], omega[j, 1], omega[j, 2]
+        v0 = (vel[j, 0] - aj * (wj1 * n2 - wj2 * n1)) - (vel[i, 0] + ai * (wi1 * n2 - wi2 * n1))
+        v1 = (vel[j, 1] - aj * (wj2 * n0 - wj0 * n2)) - (vel[i, 1] + ai * (wi2 * n0 - wi0 * n2))
+        v2 = (vel[j, 2] - aj * (wj0 * n1 - wj1 * n0)) - (vel[i, 2] + ai * (wi0 * n1 - wi1 * n0))
+        vn = v0 * n0 + v1 * n1 + v2 * n2
+        kna = kn[b] * area[b]
+        ksa = ks[b] * area[b]
+        fn[b] -= kna * vn * dt
+        fs[b, 0] -= ksa * (v0 - vn * n0) * dt
+        fs[b, 1] -= ksa * (v1 - vn * n1) * dt
+        fs[b, 2] -= ksa * (v2 - vn * n2) * dt
+        t0 = (wj0 - wi0) * dt
+        t1 = (wj1 - wi1) * dt
+        t2 = (wj2 - wi2) * dt
+        tn = t0 * n0 + t1 * n1 + t2 * n2
+        kni = kn[b] * ib[b]
+        mb[b, 0] -= kni * (t0 - tn * n0)
+        mb[b, 1] -= kni * (t1 - tn * n1)
+        mb[b, 2] -= kni * (t2 - tn * n2)
+        if dim == 3:
+            mt[b] -= ks[b] * jb[b] * tn
+        # maximum stresses (seed 000 eq 11, Potyondy & Cundall 2004), tension positive
+        fsm = np.sqrt(fs[b, 0] ** 2 + fs[b, 1] ** 2 + fs[b, 2] ** 2)
+        mbm = np.sqrt(mb[b, 0] ** 2 + mb[b, 1] ** 2 + mb[b, 2] ** 2)
+        sig_n = -fn[b] / area[b]
+        sigma = sig_n + mbm * rb[b] / ib[b]
+        tau = fsm / area[b]
+        if dim == 3:
+            tau += abs(mt[b]) * rb[b] / jb[b]
+        how = INTACT
+        if sigma >= tens[b]:
+            how = TENSILE
+        elif tau >= coh[b] - sig_n * tanphi[b]:
+            how = SHEAR
+        if how != INTACT:
+            mode[b] = how
+            newly[b] = 1
+            nnew += 1
+            brk[b, B_X] = pos[i, 0] + ai * n0
+            brk[b, B_Y] = pos[i, 1] + ai * n1
+            brk[b, B_Z] = pos[i, 2] + ai * n2
+            brk[b, B_FN] = fn[b]
+            brk[b, B_FS] = fsm
+            brk[b, B_MB] = mbm
+            brk[b, B_MT] = abs(mt[b])
+            brk[b, B_SIGMA] = sigma
+            brk[b, B_TAU] = tau
+            fn[b] = 0.0
+            mt[b] = 0.0
+            for k in range(3):
+                fs[b, k] = 0.0
+                mb[b, k] = 0.0
+                fbond[b, k] = 0.0
+                tbi[b, k] = 0.0
+                tbj[b, k] = 0.0
+            continue
+        f0 = fn[b] * n0 + fs[b, 0]
+        f1 = fn[b] * n1 + fs[b, 1]
+        f2 = fn[b] * n2 + fs[b, 2]
+        fbond[b, 0] = f0
+        fbond[b, 1] = f1
+        fbond[b, 2] = f2
+        # arm x force: j arm -aj n with F; i arm ai n with -F
+        cx = n1 * f2 - n2 * f1
+        cy = n2 * f0 - n0 * f2
+        cz = n0 * f1 - n1 * f0
+        m0 = mb[b, 0] + mt[b] * n0
+        m1 = mb[b, 1] + mt[b] * n1
+        m2 = mb[b, 2] + mt[b] * n2
+        tbj[b, 0] = -aj * cx + m0
+        tbj[b, 1] = -aj * cy + m1
+        tbj[b, 2] = -aj * cz + m2
+        tbi[b, 0] = -ai * cx - m0
+        tbi[b, 1] = -ai * cy - m1
+        tbi[b, 2] = -ai * cz - m2
+    return nnew
+
+
+@kernel
+def gather_bonds(cstart, cbond, bi, fbond, tbi, tbj, ext_force, ext_torque):
+    """Add bond forces/moments to each particle (prange over particles, fixed order)."""
+    n = cstart.shape[0] - 1
+    for p in prange(n):
+        for q in range(cstart[p], cstart[p + 1]):
+            b = cbond[q]
+            if bi[b] == p:
+                for k in range(3):
+                    ext_force[p, k] -= fbond[b, k]
+                    ext_torque[p, k] += tbi[b, k]
+            else:
+                for k in range(3):
+                    ext_force[p, k] += fbond[b, k]
+                    ext_torque[p, k] += tbj[b, k]
+
+
+def bond_csr(bi: np.ndarray, bj: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Per-particle bond index (CSR): ``cbond[cstart[p]:cstart[p+1]]`` are p's bonds."""
+    ends = np.concatenate([bi, bj])
+    ids = np.concatenate([np.arange(bi.size), np.arange(bj.size)]).astype(np.int64)
+    order = np.argsort(ends, kind="stable")
+    cstart = np.zeros(n + 1, dtype=np.int64)
+    np.cumsum(np.bincount(ends, minlength=n), out=cstart[1:])
+    return cstart, ids[order]
+
+
+def _per_bond(x: object, nb: int, name: str, allowed: str, ok: object) -> np.ndarray:
+    a = np.asarray(x, dtype=np.float64)
+    a = np.full(nb, float(a)) if a.ndim == 0 else a.reshape(-1).copy()
+    if a.shape != (nb,):
+        raise ValueError(f"bonds: {name} has shape {a.shape}, expected a scalar or ({nb},)")
+    bad = ~ok(a)  # type: ignore[operator]
+    if bad.any():
+        k = int(np.flatnonzero(bad)[0])
+        raise ValueError(f"bonds: {name} = {float(a[k])!r}: must be {allowed}")
+    return a
+
+
+class ParallelBonds:
+    """Linear parallel bonds between particle pairs (an engine ``Interaction``).
+
+    ``i``, ``j``: bonded particles; ``lambda_``: bond radius multiplier (Rb = lambda
+    min(r_i, r_j)); ``E_bond``: bond effective modulus (Pa); ``kratio`` kn/ks;
+    ``tensile_strength`` sigma_t and ``cohesion`` c (Pa); ``friction_angle`` phi (deg).
+    Scalars or one value per bond. Geometry and stiffness are fixed at construction from
+    the current radii and positions; forces start at zero.
+    """
+
+    def __init__(self, sim: Simulation, i: np.ndarray, j: np.ndarray, lambda_: float,
+                 E_bond: float | np.ndarray, kratio: float | np.ndarray,
+                 tensile_strength: float | np.ndarray, cohesion: float | np.ndarray,
+                 friction_angle: float | np.ndarray = 0.0) -> None:
+        p = sim.p
+        self.dim = p.dim
+        self.n_particles = p.n
+        bi = np.asarray(i, dtype=np.int64).reshape(-1)
+        bj = np.asarray(j, dtype=np.int64).reshape(-1)
+        if bi.shape != bj.shape:
+            raise ValueError(f"bonds: i has {bi.size} entries but j has {bj.size}")
+        nb = bi.size
+        if nb and (min(bi.min(), bj.min()) < 0 or max(bi.max(), bj.max()) >= p.n):
+            raise ValueError(f"bonds: particle indices must be in [0, {p.n - 1}]")
+        if np.any(bi == bj):
+            k = int(np.flatnonzero(bi == bj)[0])
+            raise ValueError(f"bonds: bond {k} joins particle {int(bi[k])} to itself")
+        if not (isinstance(lambda_, (int, float)) and lambda_ > 0):
+            raise ValueError(f"bonds: lambda_ = {lambda_!r}: must be a number > 0")
+        swap = bi > bj  # store i < j (like the neighbour list)
+        self.i = np.where(swap, bj, bi)
+        self.j = np.where(swap, bi, bj)
+        e = _per_bond(E_bond, nb, "E_bond", "> 0 Pa", lambda a: a > 0)
+        kr = _per_bond(kratio, nb, "kratio", "> 0", lambda a: a > 0)
+        self.tensile = _per_bond(tensile_strength, nb, "tensile_strength", "> 0 Pa",
+                                 lambda a: a > 0)
+        self.cohesion = _per_bond(cohesion, nb, "cohesion", "> 0 Pa", lambda a: a > 0)
+        phi = _per_bond(friction_angle, nb, "friction_angle", "in [0, 90) degrees",
+                        lambda a: (a >= 0) & (a < 90))
+        self.tan_phi = np.tan(np.radians(phi))
+        ri, rj = p.radius[self.i], p.radius[self.j]
+        self.rb = float(lambda_) * np.minimum(ri, rj)
+        if self.dim == 2:
+            t = p.thickness
+            self.area = 2.0 * self.rb * t
+            self.inertia = 2.0 / 3.0 * t * self.rb**3
+            self.polar = np.zeros(nb)
+        else:
+            self.area = np.pi * self.rb**2
+            self.inertia = np.pi * self.rb**4 / 4.0
+            self.polar = np.pi * self.rb**4 / 2.0
+        self.kn = e / (ri + rj)
+        self.ks = self.kn / kr
+        d = p.pos[self.j] - p.pos[self.i]
+        for k in range(3):
+            if sim.box.periodic[k]:
+                d[:, k] -= sim.box.length[k] * np.rint(d[:, k] / sim.box.length[k])
+        self.length = np.sqrt((d * d).sum(axis=1))
+        if np.any(self.length == 0.0):
+            raise ValueError("bonds: a bonded pair has coincident centres")
+        self.normal = d / self.length[:, None]
+        self.fn = np.zeros(nb)
+        self.fs = np.zeros((nb, 3))
+        self.mb = np.zeros((nb, 3))
+        self.mt = np.zeros(nb)
+        self.mode = np.zeros(nb, dtype=np.int8)
+        self.newly = np.zeros(nb, dtype=np.int8)
+        self.brk = np.zeros((nb, N_BREAK))
+        self.fbond = np.zeros((nb, 3))
+        self.tbi = np.zeros((nb, 3))
+        self.tbj = np.zeros((nb, 3))
+        self.log: list[BondBreak] = []
+        self.cstart, self.cbond = bond_csr(self.i, self.j, p.n)
+
+    # ------------------------------------------------------------------ interaction
+    @property
+    def n_bonds(self) -> int:
+        """Number of bonds (intact and broken)."""
+        return int(self.i.size)
+
+    @property
+    def intact(self) -> np.ndarray:
+        """Boolean mask of intact bonds."""
+        return self.mode == INTACT
+
+    def compute(self, sim: Simulation) -> None:
+        """Update the bonds, break what exceeds its strength, add forces to ``ext_*``."""
+        if self.n_bonds == 0:
+            return
+        p = sim.p
+        nnew = bond_forces.pick(self.n_bonds)(
+            p.pos, p.vel, p.omega, p.radius, self.i, self.j, self.rb, self.area, self.inertia,
+            self.polar, self.kn, self.ks, self.tensile, self.cohesion, self.tan_phi, self.fn,
+            self.fs, self.mb, self.mt, self.normal, self.mode, self.newly, self.brk,
+            self.fbond, self.tbi, self.tbj, self.dim, sim.dt, sim.box.length,
+            sim.box.periodic)
+        if nnew:
+            self._log_breaks(sim)
+        gather_bonds.pick(p.n)(self.cstart, self.cbond, self.i, self.fbond, self.tbi,
+                               self.tbj, sim.ext_force, sim.ext_torque)
+
+    def _log_breaks(self, sim: Simulation) -> None:
+        # the kernel runs before the step counter advances: the break belongs to step + 1
+        for b in np.flatnonzero(self.newly):
+            r = self.brk[b]
+            self.log.append(BondBreak(
+                time=sim.time + sim.dt, step=sim.step_count + 1,
+                position=(float(r[B_X]), float(r[B_Y]), float(r[B_Z])),
+                mode=MODE_NAMES[int(self.mode[b])], i=int(self.i[b]), j=int(self.j[b]),
+                fn=float(r[B_FN]), fs=float(r[B_FS]), mb=float(r[B_MB]), mt=float(r[B_MT]),
+                sigma=float(r[B_SIGMA]), tau=float(r[B_TAU])))
+        self.newly[:] = 0
+
+    def broken_count(self, mode: str | None = None) -> int:
+        """Number of broken bonds, all or of one mode ("tensile" or "shear")."""
+        if mode is None:
+            return int(np.count_nonzero(self.mode != INTACT))
+        if mode not in MODES:
+            raise ValueError(f"bonds: mode = {mode!r}: must be one of {sorted(MODES)} or None")
+        return int(np.count_nonzero(self.mode == MODES[mode]))
+
+    def stresses(self) -> tuple[np.ndarray, np.ndarray]:
+        """Current maximum stresses (sigma, tau) per bond (Pa, eq 11; broken bonds: 0)."""
+        mbm = np.linalg.norm(self.mb, axis=1)
+        sigma = -self.fn / self.area + mbm * self.rb / self.inertia
+        tau = np.linalg.norm(self.fs, axis=1) / self.area
+        if self.dim == 3:
+            tau = tau + np.abs(self.mt) * self.rb / self.polar
+        return sigma, tau
+
+    def critical_step(self, sim: Simulation) -> float:
+        """Critical time step (s) from bond stiffness: ``sqrt(m/k)`` over bond ends with k
+        the summed translational (kn A, ks A) and rotational stiffness of a particle's
+        bonds (as PFC's estimate); inf without bonds."""
+        if self.n_bonds == 0:
+            return math.inf
+        p = sim.p
+        n = p.n
+        kt = np.zeros(n)
+        kr = np.zeros(n)
+        kmax = np.maximum(self.kn, self.ks) * self.area
+        krot = self.kn * self.inertia + self.ks * self.area * (0.5 * self.length) ** 2
+        for ends in (self.i, self.j):
+            np.add.at(kt, ends, kmax)
+            np.add.at(kr, ends, krot)
+        sel = kt > 0
+        dt_t = np.sqrt(p.mass[sel] / kt[sel]).min()
+        dt_r = np.sqrt(p.inertia[sel] / kr[sel]).min()
+        return float(min(dt_t, dt_r))
+
+    def thermal_load(self, dT: np.ndarray, alpha: np.ndarray) -> None:
+        """Constrained thermal expansion of intact bonds (seed 000 eq 13): the normal force
+        grows by ``kn A alpha L dT`` (+ = compression here; ``-kn A alpha L dT`` in PFC's
+        tension-positive sign), with dT and alpha the means over the two particles."""
+        if self.n_bonds == 0:
+            return
+        db = 0.5 * (dT[self.i] + dT[self.j])
+        ab = 0.5 * (alpha[self.i] + alpha[self.j])
+        self.fn += np.where(self.intact, self.kn * self.area * ab * self.length * db, 0.0)
+
+    # ------------------------------------------------------------------ checkpoints
+    _ARRAYS = ("i", "j", "rb", "area", "inertia", "polar", "kn", "ks", "tensile", "cohesion",
+               "tan_phi", "length", "normal", "fn", "fs", "mb", "mt", "mode", "fbond", "tbi",
+               "tbj")
+    _LOG_F = ("time", "fn", "fs", "mb", "mt", "sigma", "tau")
+
+    def state(self) -> dict[str, np.ndarray]:
+        """All bond arrays and the break log, for checkpoints."""
+        out = {k: getattr(self, k) for k in self._ARRAYS}
+        lg = self.log
+        for k in self._LOG_F:
+            out[f"log_{k}"] = np.array([getattr(r, k) for r in lg], dtype=np.float64)
+        out["log_step"] = np.array([r.step for r in lg], dtype=np.int64)
+        out["log_ij"] = np.array([(r.i, r.j) for r in lg], dtype=np.int64).reshape(-1, 2)
+        out["log_mode"] = np.array([MODES[r.mode] for r in lg], dtype=np.int8)
+        out["log_pos"] = np.array([r.position for r in lg], dtype=np.float64).reshape(-1, 3)
+        return out
+
+    def set_state(self, state: dict[str, np.ndarray]) -> None:
+        """Restore what ``state`` returned (same particle count)."""
+        for k in self._ARRAYS:
+            setattr(self, k, np.array(state[k]))
+        nb = self.i.size
+        self.newly = np.zeros(nb, dtype=np.int8)
+        self.brk = np.zeros((nb, N_BREAK))
+        self.cstart, self.cbond = bond_csr(self.i, self.j, self.n_particles)
+        self.log = []
+        for q in range(state["log_step"].size):
+            f = {k: float(state[f"log_{k}"][q]) for k in self._LOG_F}
+            self.log.append(BondBreak(
+                step=int(state["log_step"][q]),
+                position=tuple(float(x) for x in state["log_pos"][q]),  # type: ignore[arg-type]
+                mode=MODE_NAMES[int(state["log_mode"][q])], i=int(state["log_ij"][q, 0]),
+                j=int(state["log_ij"][q, 1]), **f))
+
+
+def install_bonds_by_gap(sim: Simulation, gap: float, lambda_: float, E_bond: float,
+                         kratio: float, tensile_strength: float, cohesion: float,
+                         friction_angle: float = 0.0, groups: list[int] | None = None
+                         ) -> ParallelBonds:
+    """Bond every pair whose surface gap is below ``gap`` (m; overlapping pairs too) and add
+    the bonds to ``sim`` as an interaction.
+
+    ``groups``: bond only pairs whose two particles share a group in this list (``None``:
+    all pairs). See ``ParallelBonds`` for the other parameters (Pa, degrees).
+    """
+    if not (isinstance(gap, (int, float)) and gap >= 0):
+        raise ValueError(f"bonds: gap = {gap!r}: must be a number >= 0 m")
+    p = sim.p
+    nl = neighbors.build(p.pos, p.radius, max(float(gap), 1e-12 * float(p.radius.max())),
+                         sim.box.lo, sim.box.hi, sim.box.periodic)
+    i, j = nl.pair_i.astype(np.int64), nl.pair_j.astype(np.int64)
+    d = p.pos[j] - p.pos[i]
+    for k in range(3):
+        if sim.box.periodic[k]:
+            d[:, k] -= sim.box.length[k] * np.rint(d[:, k] / sim.box.length[k])
+    g = np.sqrt((d * d).sum(axis=1)) - p.radius[i] - p.radius[j]
+    keep = g < gap
+    if groups is not None:
+        gi, gj = p.group[i], p.group[j]
+        keep &= (gi == gj) & np.isin(gi, np.asarray(list(groups), dtype=np.int64))
+    bonds = ParallelBonds(sim, i[keep], j[keep], lambda_, E_bond, kratio, tensile_strength,
+                          cohesion, friction_angle)
+    sim.add_interaction(bonds)
+    return bonds
