@@ -1,0 +1,381 @@
+"""Half-space BEM backend on tamaas (DESIGN.md "The fretting FE-DE model", backend 1).
+
+Model (seed 003 sections 3.3 and 6.1, replacing the Abaqus FE phase):
+
+* Normal problem: frictionless elastic contact of the two surfaces, reduced to a rigid
+  surface (the summed recessions) on an elastic half-space of contact modulus
+  E* = 1 / ((1 - nu1^2)/E1 + (1 - nu2^2)/E2), solved under load control by
+  :class:`tamaas.PolonskyKeerRey` on a periodic square window of ``n x n`` points that moves
+  with the upper body. Non-dimensional inside (length: window side, stress: E*).
+* Tangential problem, gross slip (stroke >> contact radius, the default): q = mu p opposing
+  the relative sliding direction; exact for elastically similar bodies (Dundurs beta = 0, no
+  normal-tangential coupling). Slip increment = rigid relative displacement increment at
+  every contact point (the elastic tangential compliance, a few um against a 600 um stroke,
+  is neglected).
+* Tangential problem, ``regime="ciavarella-jaeger"``: partial slip after every reversal by
+  the Ciavarella-Jaeger superposition q = q_rev - s f mu (p - p*) (f = 1 on first loading,
+  2 after a reversal, s the sliding sign), p* the normal solution of the same gap at the
+  reduced true approach d* = d - |offset - offset_rev| / (f mu kappa), stick zone = contact
+  of p*; kappa = sum (2 - nu_i)/G_i / (2 sum (1 - nu_i)/G_i) is Mindlin's tangential to
+  normal compliance ratio (3-D superposition approximate: Cerruti's nu x^2/r^3 term is
+  neglected, as in Mindlin's solution). Accumulated slip since the reversal:
+  f mu kappa gap*(x) in partial slip, offset change - f mu kappa (d - g(x)) in gross slip,
+  so the dissipated energy includes the elastic tangential compliance exactly (within the
+  approximation) whatever the increment size. Gross slip reached after 2 mu kappa d.
+* Subsurface stress under each body: tamaas ``volume_2d`` model with the Boussinesq-Cerruti
+  gradient and Hooke operators applied to that body's surface traction (normal + shear).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import tamaas as tm
+from numpy.typing import NDArray
+
+from tribodem.contact.base import (
+    BODIES,
+    Body,
+    ElasticBody,
+    FirstBodySolver,
+    IncrementResult,
+    SubsurfaceStress,
+    _check_positive,
+    contact_modulus,
+    dundurs_beta,
+)
+from tribodem.contact.geometry import HertzSphere, Recession, crossed_cylinders
+
+tm.set_log_level(tm.LogLevel.error)
+
+REGIMES = ("gross", "ciavarella-jaeger")
+
+
+class WindowTooSmallError(RuntimeError):
+    """The contact reached the edge of the periodic window: enlarge ``window``."""
+
+
+def _estimate_contact_radius(
+    upper: Recession, lower: Recession, load: float, modulus: float
+) -> float:
+    """Hertz contact radius from the curvatures of the summed recession at the origin, m."""
+    h = 1e-5
+    z = np.zeros(1)
+
+    def g(x: float, y: float) -> float:
+        xs, ys = z + x, z + y
+        return float(upper(xs, ys)[0] + lower(xs, ys)[0])
+
+    kx = (g(h, 0) + g(-h, 0) - 2 * g(0, 0)) / h**2
+    ky = (g(0, h) + g(0, -h) - 2 * g(0, 0)) / h**2
+    if not (kx > 0 and ky > 0):
+        raise ValueError(
+            "window is None but the summed recession has no positive curvature at the origin "
+            f"(kx = {kx:.3g}, ky = {ky:.3g} 1/m): give window (m) explicitly"
+        )
+    return HertzSphere(1.0 / math.sqrt(kx * ky), load, modulus).contact_radius
+
+
+class HalfSpaceSolver(FirstBodySolver):
+    """Elastic half-space first-body solver (tamaas); SI in and out.
+
+    Defaults: crossed cylinders of 8 mm diameter (axes: upper along y, lower along x, stroke
+    along x), 100 N, friction 0.6, EN24T on both sides, 256 x 256 window of 10 Hertz contact
+    radii (about 1.3 mm, dx about 5.1 um), ``regime="gross"``.
+
+    ``upper``/``lower`` are recessions (callables or :class:`HeightMap`, m); ``load`` N;
+    ``window`` (m) is the side of the periodic window; when None it is ``window_radii``
+    Hertz radii estimated from the summed recession's curvature at the origin (10 um
+    finite differences: give ``window`` explicitly for coarse height maps). ``regime`` is
+    ``"gross"`` (q = mu p) or ``"ciavarella-jaeger"`` (partial slip after reversals).
+    """
+
+    def __init__(
+        self,
+        upper: Recession | None = None,
+        lower: Recession | None = None,
+        load: float = 100.0,
+        friction: float = 0.6,
+        upper_material: ElasticBody | None = None,
+        lower_material: ElasticBody | None = None,
+        n: int = 256,
+        window: float | None = None,
+        window_radii: float = 10.0,
+        tolerance: float = 1e-10,
+        regime: str = "gross",
+    ) -> None:
+        if (upper is None) != (lower is None):
+            raise ValueError("upper and lower must both be given or both be None (defaults)")
+        if upper is None or lower is None:
+            upper, lower = crossed_cylinders()
+        self.upper, self.lower = upper, lower
+        self.load = _check_positive("load", load)
+        self.friction = _check_positive("friction", friction, allow_zero=True)
+        self.upper_material = upper_material or ElasticBody()
+        self.lower_material = lower_material or ElasticBody()
+        if int(n) != n or n < 16 or n % 2:
+            raise ValueError(f"n = {n!r} is not allowed: must be an even integer >= 16")
+        self.n = int(n)
+        if regime not in REGIMES:
+            raise ValueError(
+                f"regime = {regime!r} is not allowed: use 'gross' (q = mu p) or "
+                "'ciavarella-jaeger' (partial slip after reversals)"
+            )
+        self.regime = regime
+        self.tolerance = _check_positive("tolerance", tolerance)
+        self.modulus = contact_modulus(self.upper_material, self.lower_material)
+        self.beta = dundurs_beta(self.upper_material, self.lower_material)
+        if window is None:
+            a = _estimate_contact_radius(upper, lower, self.load, self.modulus)
+            window = _check_positive("window_radii", window_radii) * a
+        self.dx = _check_positive("window", window) / self.n
+        self._model = tm.ModelFactory.createModel(
+            tm.model_type.basic_2d, [1.0, 1.0], [self.n, self.n]
+        )
+        self._model.E = 1.0
+        self._model.nu = 0.0
+        self._model_star = tm.ModelFactory.createModel(self._model)
+        um, lm = self.upper_material, self.lower_material
+        #: Mindlin tangential / normal compliance ratio kappa (1.214 for nu = 0.3)
+        self.kappa = ((2 - um.poisson) / um.shear + (2 - lm.poisson) / lm.shear) / (
+            2 * ((1 - um.poisson) / um.shear + (1 - lm.poisson) / lm.shear)
+        )
+        c = np.arange(-self.n + 1, self.n) * self.dx
+        xe, ye = np.meshgrid(c, c, indexing="ij")
+        self._kernel = _cell_integral(xe, ye, self.dx)  # int over a cell of 1/r, m
+        self.reset()
+
+    def reset(self) -> None:
+        self._offset: float | None = None
+        self._direction = 0.0
+        self._model.traction[:] = 0.0
+        self._rev_offset = 0.0
+        self._rev_traction = np.zeros((self.n, self.n))
+        self._factor = 1.0
+        self._slip_acc = np.zeros((self.n, self.n))
+        self._traction = np.zeros((self.n, self.n))
+
+    def approach(self, pressure: NDArray[np.float64], gap: NDArray[np.float64]) -> float:
+        """True (non-periodic) half-space rigid approach d of a solution, m.
+
+        d = g(x0) - min g + u(x0) at the peak-pressure point x0, with u the sum of both
+        bodies' normal displacements, (1 / (pi E*)) int p / r dA, cell by cell exactly.
+        """
+        i, j = np.unravel_index(int(np.argmax(pressure)), pressure.shape)
+        n = self.n
+        k = self._kernel[n - 1 - i : 2 * n - 1 - i, n - 1 - j : 2 * n - 1 - j]
+        u = float((k * pressure).sum()) / (math.pi * self.modulus)
+        return float(gap[i, j] - gap.min()) + u
+
+    def gap(self, offset: float) -> NDArray[np.float64]:
+        """Summed recession on the window with the upper body at ``offset`` (m), [n, n], m."""
+        c = self.coords
+        xw, yw = np.meshgrid(c, c, indexing="ij")
+        return np.asarray(self.upper(xw, yw) + self.lower(xw + offset, yw), dtype=float)
+
+    def _normal(
+        self, g: NDArray[np.float64], load: float, model: tm.Model | None = None
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Pressure (Pa) and gap (m) of the load-controlled normal problem on gap ``g``."""
+        model = self._model if model is None else model
+        gt = (g - g.min()) / self.window
+        surface = np.ascontiguousarray(-gt)
+        solver = tm.PolonskyKeerRey(model, surface, self.tolerance)
+        solver.max_iter = 10000
+        solver.solve(load / (self.window**2 * self.modulus))
+        p = np.array(model.traction, dtype=float) * self.modulus
+        gap = np.array(model.displacement, dtype=float) + gt
+        gap = np.where(p > 0.0, 0.0, np.maximum(gap - gap[p > 0.0].mean(), 0.0)) * self.window
+        return p, gap
+
+    def _check_window(self, p: NDArray[np.float64], offset: float) -> None:
+        edge = max(p[0].max(), p[-1].max(), p[:, 0].max(), p[:, -1].max())
+        if edge > 0.0:
+            raise WindowTooSmallError(
+                f"contact touches the window edge at offset {offset:.4g} m (window "
+                f"{self.window:.4g} m, n {self.n}): enlarge window"
+            )
+
+    def _reduced(
+        self, g: NDArray[np.float64], d_star: float, load: float, d: float
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Normal solution (p*, gap*) of gap ``g`` at true approach ``d_star`` < d, m."""
+        lo, hi = 0.0, load  # bracket on the load; d(P) is increasing
+        p_star = load * (d_star / d) ** 1.5
+        for _ in range(40):
+            p, gap = self._normal(g, p_star, self._model_star)
+            dd = self.approach(p, gap)
+            if abs(dd - d_star) <= 1e-6 * d:
+                break
+            if dd > d_star:
+                hi = p_star
+            else:
+                lo = p_star
+            guess = p_star * (d_star / dd) ** 1.5
+            p_star = guess if lo < guess < hi else 0.5 * (lo + hi)
+        return p, gap
+
+    def solve_increment(self, offset: float) -> IncrementResult:
+        offset = float(offset)
+        if not math.isfinite(offset):
+            raise ValueError(f"offset = {offset!r} is not allowed: must be finite (m)")
+        start = offset if self._offset is None else self._offset
+        step = offset - start
+        if step != 0.0:
+            new_dir = math.copysign(1.0, step)
+            if self._direction != 0.0 and new_dir != self._direction:
+                # reversal: Masing memory of the last reversal point and its traction
+                self._rev_offset, self._factor = start, 2.0
+                self._rev_traction = self._traction.copy()
+                self._slip_acc[:] = 0.0
+            self._direction = new_dir
+        g = self.gap(offset)
+        p, gap = self._normal(g, self.load)
+        self._check_window(p, offset)
+        contact = p > 0.0
+        qx = np.zeros_like(p)
+        slip_x = np.zeros_like(p)
+        stick = None
+        if self._direction != 0.0 and self.regime == "gross":
+            qx = -self.friction * p * self._direction
+            slip_x[contact] = step
+        elif self._direction != 0.0:
+            qx, acc, stick = self._ciavarella_jaeger(g, p, gap, offset)
+            slip_x = np.where(contact, self._direction * (acc - self._slip_acc), 0.0)
+            self._slip_acc = acc
+        self._traction = qx
+        self._offset = offset
+        cell = self.dx**2
+        return IncrementResult(
+            offset=offset,
+            start_offset=start,
+            direction=self._direction,
+            pressure=p,
+            traction=np.stack([qx, np.zeros_like(qx)], axis=-1),
+            slip=np.stack([slip_x, np.zeros_like(slip_x)], axis=-1),
+            contact_area=float(contact.sum() * cell),
+            normal_load=float(p.sum() * cell),
+            stick=stick,
+        )
+
+    def _ciavarella_jaeger(
+        self,
+        g: NDArray[np.float64],
+        p: NDArray[np.float64],
+        gap: NDArray[np.float64],
+        offset: float,
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.bool_]]:
+        """(q_x on the upper body, accumulated slip since reversal, stick mask)."""
+        mu, f, s = self.friction, self._factor, self._direction
+        travel = abs(offset - self._rev_offset)
+        d = self.approach(p, gap)
+        d_star = d - travel / (f * mu * self.kappa) if mu > 0 else -1.0
+        gt = g - g.min()
+        if d_star <= 0.0:  # gross slip
+            qx = -s * mu * p
+            acc = np.where(p > 0, np.maximum(travel - f * mu * self.kappa * (d - gt), 0.0), 0.0)
+            return qx, acc, np.zeros(p.shape, dtype=bool)
+        if travel == 0.0:
+            return self._rev_traction.copy(), np.zeros_like(p), p > 0
+        p_star, gap_star = self._reduced(g, d_star, self.load, d)
+        qx = self._rev_traction - s * f * mu * (p - p_star)
+        qx = np.clip(qx, -mu * p, mu * p)
+        acc = np.where(p > 0, f * mu * self.kappa * gap_star, 0.0)
+        return qx, acc, p_star > 0
+
+    def subsurface_stress(
+        self,
+        result: IncrementResult,
+        body: Body = "lower",
+        depth: float | None = None,
+        nz: int = 33,
+    ) -> SubsurfaceStress:
+        """Stress under ``body`` for a solved increment (frame: x, y, z = depth into body).
+
+        ``depth`` defaults to 3 equivalent contact radii sqrt(area / pi). The lower body's
+        window centre lies at lab x = ``result.offset``. Shear traction applied: ``traction``
+        on the upper body, ``-traction`` on the lower one.
+        """
+        if body not in BODIES:
+            raise ValueError(f"body = {body!r} is not allowed: use 'upper' or 'lower'")
+        if int(nz) != nz or nz < 2:
+            raise ValueError(f"nz = {nz!r} is not allowed: must be an integer >= 2")
+        if result.pressure.shape != (self.n, self.n):
+            raise ValueError(
+                f"result.pressure has shape {result.pressure.shape}: expected ({self.n}, "
+                f"{self.n}) from this solver"
+            )
+        if depth is None:
+            depth = 3.0 * math.sqrt(max(result.contact_area, self.dx**2) / math.pi)
+        depth = _check_positive("depth", depth)
+        mat = self.upper_material if body == "upper" else self.lower_material
+        sign = 1.0 if body == "upper" else -1.0
+        nz = int(nz)
+        vol = tm.ModelFactory.createModel(
+            tm.model_type.volume_2d, [depth / self.window, 1.0, 1.0], [nz, self.n, self.n]
+        )
+        vol.E = 1.0
+        vol.nu = mat.poisson
+        tm.ModelFactory.registerVolumeOperators(vol)
+        vol.traction[..., 0] = sign * result.traction[..., 0] / self.modulus
+        vol.traction[..., 1] = sign * result.traction[..., 1] / self.modulus
+        vol.traction[..., 2] = result.pressure / self.modulus
+        vol.operators["boussinesq_gradient"](vol.traction, vol["strain"])
+        vol.operators["hooke"](vol["strain"], vol["stress"])
+        raw = np.asarray(vol["stress"])
+        # tamaas 2.9 order: xx, yy, zz, xy, xz, yz, shear in Mandel notation (x sqrt 2);
+        # reorder to VOIGT_ORDER (xx, yy, zz, yz, xz, xy) with true shear components.
+        stress = raw[..., [0, 1, 2, 5, 4, 3]] * self.modulus
+        del raw, vol
+        stress[..., 3:] /= math.sqrt(2.0)
+        return SubsurfaceStress(
+            body=body,
+            z=np.linspace(0.0, depth, nz),
+            x=self.coords,
+            y=self.coords,
+            stress=stress,
+            von_mises=von_mises(stress),
+            tresca=max_shear(stress),
+        )
+
+
+def _cell_integral(x: NDArray[np.float64], y: NDArray[np.float64], h: float) -> NDArray[np.float64]:
+    """Integral of 1/r over the square cell of side ``h`` centred at (x, y), m."""
+
+    def prim(u: NDArray[np.float64], v: NDArray[np.float64]) -> NDArray[np.float64]:
+        r = np.hypot(u, v)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            a = np.where(u != 0, u * np.log((v + r) / np.abs(u)), 0.0)
+            b = np.where(v != 0, v * np.log((u + r) / np.abs(v)), 0.0)
+        return np.nan_to_num(a) + np.nan_to_num(b)
+
+    x1, x2, y1, y2 = x - h / 2, x + h / 2, y - h / 2, y + h / 2
+    return prim(x2, y2) - prim(x1, y2) - prim(x2, y1) + prim(x1, y1)
+
+
+def von_mises(stress: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Von Mises stress of Voigt stresses [..., 6] (xx, yy, zz, yz, xz, xy), Pa."""
+    s = stress
+    j2 = (
+        (s[..., 0] - s[..., 1]) ** 2 + (s[..., 1] - s[..., 2]) ** 2 + (s[..., 2] - s[..., 0]) ** 2
+    ) / 6.0 + (s[..., 3:] ** 2).sum(-1)
+    return np.sqrt(3.0 * j2)
+
+
+def max_shear(stress: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Maximum shear (Tresca) stress (s1 - s3) / 2 of Voigt stresses [..., 6], Pa."""
+    s = np.asarray(stress, dtype=float)
+    flat = s.reshape(-1, 6)
+    out = np.empty(flat.shape[0])
+    chunk = 1 << 16
+    for i in range(0, flat.shape[0], chunk):
+        c = flat[i : i + chunk]
+        t = np.empty((c.shape[0], 3, 3))
+        t[:, 0, 0], t[:, 1, 1], t[:, 2, 2] = c[:, 0], c[:, 1], c[:, 2]
+        t[:, 1, 2] = t[:, 2, 1] = c[:, 3]
+        t[:, 0, 2] = t[:, 2, 0] = c[:, 4]
+        t[:, 0, 1] = t[:, 1, 0] = c[:, 5]
+        ev = np.linalg.eigvalsh(t)
+        out[i : i + chunk] = 0.5 * (ev[:, -1] - ev[:, 0])
+    return out.reshape(s.shape[:-1])
