@@ -1,0 +1,262 @@
+"""The fretting wear loop (seed 003 figure 3.1 without debris; sections 3.3.3, 6.3).
+
+Per simulated cycle: move the upper body through 0 -> +A -> 0 -> -A -> 0 with the first-body
+solver on the *current* worn surfaces, stream every increment to the criterion, get the
+cycle's wear depth on both bodies (upper spot grid, lower track grid), add it to the
+cumulative wear maps and to the recessions the solver sees (geometry update: the surface
+recedes by the worn depth, the half-space analogue of eqs 3.7-3.8), integrate the worn
+volume exactly on the grids (sum of depth x cell area) and record the cycle.
+
+Cycle-jumping (:mod:`tribodem.cyclejump`): the state is the pair of cumulative wear-depth
+maps (flattened into one array). After each simulated cycle the strategy may skip ``n``
+cycles; the maps are extrapolated element by element and ``n`` rows with ``jumped = 1``
+are recorded (maps interpolated linearly across the jump, per-cycle quantities such as the
+dissipated energy carried from the last simulated cycle).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from tribodem.contact.base import FirstBodySolver, cycle_offsets
+from tribodem.contact.geometry import HeightMap, Recession
+from tribodem.contact.halfspace import WindowTooSmallError
+from tribodem.cyclejump import JumpStrategy
+from tribodem.fretting.criteria import Criterion, ThresholdCriterion, TrackGrid
+
+#: Columns of ``results.csv`` (one row per simulated or jumped cycle).
+RESULT_COLUMNS = (
+    "cycle",
+    "jumped",
+    "wear_depth_upper_m",
+    "wear_depth_lower_m",
+    "wear_volume_upper_m3",
+    "wear_volume_lower_m3",
+    "dissipated_energy_J",
+    "max_pressure_Pa",
+    "max_traction_Pa",
+    "contact_area_m2",
+)
+
+
+class WornSurface:
+    """Recession of a worn body: ``base(x, y) + wear(x, y)`` (m), wear a :class:`HeightMap`."""
+
+    def __init__(self, base: Recession, wear: HeightMap) -> None:
+        self.base = base
+        self.wear = wear
+
+    def __call__(self, x: NDArray[np.float64], y: NDArray[np.float64]) -> NDArray[np.float64]:
+        return np.asarray(self.base(x, y), dtype=float) + self.wear(x, y)
+
+
+@dataclass
+class FrettingHistory:
+    """Outcome of :meth:`FrettingLoop.run`. SI units."""
+
+    rows: list[dict[str, Any]]
+    grid: TrackGrid
+    wear_upper: NDArray[np.float64]  #: cumulative wear depth, m, [n, n]
+    wear_lower: NDArray[np.float64]  #: cumulative wear depth, m, [n_track, n]
+    profiles_upper: list[NDArray[np.float64]]  #: wear at the central section per row, m
+    profiles_lower: list[NDArray[np.float64]]
+    base_upper: NDArray[np.float64]  #: unworn recession at the central section, m
+    base_lower: NDArray[np.float64]
+    cycles_simulated: int = 0
+    cycles_jumped: int = 0
+    wall_time_s: float = 0.0
+    stopped: str | None = None  #: reason the run stopped early (None: completed)
+    criterion_info: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def cumulative_energy(self) -> float:
+        """Interface energy dissipated over all recorded cycles, J."""
+        return float(sum(r["dissipated_energy_J"] for r in self.rows))
+
+    def volume(self, body: str) -> float:
+        """Exact worn volume of ``body`` on its grid (sum of depth x cell area), m^3."""
+        w = self.wear_upper if body == "upper" else self.wear_lower
+        return float(w.sum() * self.grid.cell_area)
+
+    def summary(self) -> dict[str, Any]:
+        """Totals for ``summary.json``."""
+        last = self.rows[-1] if self.rows else {}
+        return {
+            "cycles": int(last.get("cycle", 0)),
+            "cycles_simulated": self.cycles_simulated,
+            "cycles_jumped": self.cycles_jumped,
+            "wall_time_s": self.wall_time_s,
+            "stopped": self.stopped,
+            "wear_volume_upper_m3": self.volume("upper"),
+            "wear_volume_lower_m3": self.volume("lower"),
+            "wear_depth_upper_m": float(self.wear_upper.max(initial=0.0)),
+            "wear_depth_lower_m": float(self.wear_lower.max(initial=0.0)),
+            "wear_depth_mean_scar_upper_m": _scar_mean(self.wear_upper),
+            "wear_depth_mean_scar_lower_m": _scar_mean(self.wear_lower),
+            "dissipated_energy_total_J": self.cumulative_energy,
+            "grid": {"n": self.grid.n, "dx_m": self.grid.dx, "n_track": self.grid.n_track},
+            "criterion_last_cycle": self.criterion_info,
+        }
+
+
+def _scar_mean(w: NDArray[np.float64]) -> float:
+    """Mean wear depth over the worn points (depth > 0), m (seed 6.3: "averaged wear depth
+    over all nodes in the wear scar")."""
+    worn = w > 0
+    return float(w[worn].mean()) if worn.any() else 0.0
+
+
+class FrettingLoop:
+    """Fretting wear loop on a first-body solver with worn-surface geometry update.
+
+    ``solver`` must expose its surfaces as attributes ``upper`` and ``lower`` (recessions,
+    m), as :class:`tribodem.contact.HalfSpaceSolver` does; the loop replaces them by
+    :class:`WornSurface` each cycle. ``amplitude`` m, ``n_increments`` per cycle (multiple
+    of 4). ``strategy``: a :class:`tribodem.cyclejump.JumpStrategy` or None (no jumping).
+    """
+
+    def __init__(
+        self,
+        solver: FirstBodySolver,
+        criterion: Criterion,
+        amplitude: float = 0.3e-3,
+        n_increments: int = 48,
+        strategy: JumpStrategy | None = None,
+    ) -> None:
+        if not (hasattr(solver, "upper") and hasattr(solver, "lower")):
+            raise TypeError("solver must expose its surfaces as .upper and .lower recessions")
+        self.solver = solver
+        self.criterion = criterion
+        self.offsets = cycle_offsets(amplitude, n_increments)
+        self.amplitude = float(amplitude)
+        self.strategy = strategy
+        if isinstance(criterion, ThresholdCriterion):
+            criterion.set_increments(n_increments)
+        n, dx = solver.n, solver.dx
+        self.grid = TrackGrid(n=n, dx=dx, pad=int(math.ceil(self.amplitude / dx)) + 1)
+        self.base_upper: Recession = solver.upper  # type: ignore[attr-defined]
+        self.base_lower: Recession = solver.lower  # type: ignore[attr-defined]
+        self.wear_upper = np.zeros((n, n))
+        self.wear_lower = np.zeros((self.grid.n_track, n))
+
+    def _apply_geometry(self) -> None:
+        g = self.grid
+        y0 = float(g.y[0])
+        up = HeightMap(self.wear_upper, g.dx, g.dx, float(g.x_upper[0]), y0)
+        lo = HeightMap(self.wear_lower, g.dx, g.dx, float(g.x_lower[0]), y0)
+        self.solver.upper = WornSurface(self.base_upper, up)  # type: ignore[attr-defined]
+        self.solver.lower = WornSurface(self.base_lower, lo)  # type: ignore[attr-defined]
+
+    def _state(self) -> NDArray[np.float64]:
+        return np.concatenate([self.wear_upper.ravel(), self.wear_lower.ravel()])
+
+    def _set_state(self, s: NDArray[np.float64]) -> None:
+        k = self.wear_upper.size
+        self.wear_upper = s[:k].reshape(self.wear_upper.shape).copy()
+        self.wear_lower = s[k:].reshape(self.wear_lower.shape).copy()
+
+    def simulate_cycle(self) -> dict[str, float]:
+        """One cycle on the current surfaces; adds its wear; returns per-cycle quantities."""
+        self._apply_geometry()
+        crit = self.criterion
+        crit.begin_cycle(self.grid, self.solver)
+        cell = self.grid.cell_area
+        energy = pmax = qmax = area = 0.0
+        for i, s in enumerate(self.offsets):
+            inc = self.solver.solve_increment(float(s))
+            crit.add_increment(i, inc)
+            energy += float(inc.energy_density.sum()) * cell
+            pmax = max(pmax, inc.max_pressure)
+            qmax = max(qmax, inc.max_traction)
+            area += inc.contact_area
+        du, dl = crit.depths()
+        if np.any(du < 0) or np.any(dl < 0):
+            raise RuntimeError(f"criterion '{crit.name}' returned a negative wear depth")
+        self.wear_upper = self.wear_upper + du
+        self.wear_lower = self.wear_lower + dl
+        return {
+            "dissipated_energy_J": energy,
+            "max_pressure_Pa": pmax,
+            "max_traction_Pa": qmax,
+            "contact_area_m2": area / len(self.offsets),
+        }
+
+    def _row(self, cycle: int, jumped: bool, per_cycle: dict[str, float]) -> dict[str, Any]:
+        cell = self.grid.cell_area
+        return {
+            "cycle": cycle,
+            "jumped": int(jumped),
+            "wear_depth_upper_m": float(self.wear_upper.max()),
+            "wear_depth_lower_m": float(self.wear_lower.max()),
+            "wear_volume_upper_m3": float(self.wear_upper.sum() * cell),
+            "wear_volume_lower_m3": float(self.wear_lower.sum() * cell),
+            **per_cycle,
+        }
+
+    def run(
+        self,
+        cycles: int,
+        progress: Callable[[dict[str, Any]], None] | None = None,
+    ) -> FrettingHistory:
+        """Run ``cycles`` cycles (simulated or jumped). A contact that outgrows the solver
+        window stops the run early (``history.stopped`` says why; rows so far are kept)."""
+        if int(cycles) != cycles or cycles < 1:
+            raise ValueError(f"cycles = {cycles!r} is not allowed: must be an integer >= 1")
+        t0 = time.perf_counter()
+        g = self.grid
+        j = g.n // 2
+        hist = FrettingHistory(
+            rows=[], grid=g, wear_upper=self.wear_upper, wear_lower=self.wear_lower,
+            profiles_upper=[], profiles_lower=[],
+            base_upper=np.asarray(self.base_upper(g.x_upper, np.zeros(g.n)), dtype=float),
+            base_lower=np.asarray(self.base_lower(g.x_lower, np.zeros(g.n_track)), dtype=float),
+        )
+
+        def record(row: dict[str, Any]) -> None:
+            hist.rows.append(row)
+            hist.profiles_upper.append(self.wear_upper[:, j].copy())
+            hist.profiles_lower.append(self.wear_lower[:, j].copy())
+            if progress is not None:
+                progress(row)
+
+        self.solver.reset()
+        self._apply_geometry()
+        self.solver.solve_increment(0.0)  # normal loading at offset 0
+        if self.strategy is not None:
+            self.strategy.observe(0, self._state())
+        c = 0
+        while c < cycles:
+            try:
+                per = self.simulate_cycle()
+            except WindowTooSmallError as err:
+                hist.stopped = f"cycle {c + 1}: {err}"
+                break
+            c += 1
+            hist.cycles_simulated += 1
+            record(self._row(c, False, per))
+            if self.strategy is None or c >= cycles:
+                continue
+            self.strategy.observe(c, self._state())
+            n = min(int(self.strategy.propose_jump()), cycles - c)
+            if n <= 0:
+                continue
+            old = self._state()
+            new = np.asarray(self.strategy.extrapolate(old, n), dtype=float)
+            new = np.maximum(new, old)  # wear never heals
+            for k in range(1, n + 1):
+                self._set_state(old + (new - old) * (k / n))
+                record(self._row(c + k, True, per))
+            c += n
+            hist.cycles_jumped += n
+        self._apply_geometry()  # the solver holds the final worn surfaces
+        hist.wear_upper, hist.wear_lower = self.wear_upper, self.wear_lower
+        hist.criterion_info = self.criterion.info()
+        hist.wall_time_s = time.perf_counter() - t0
+        return hist
