@@ -39,12 +39,18 @@ def _root(
 
 
 def _register() -> None:
+    from tribodem.braking.cli import braking_app
     from tribodem.cyclejump_cli import jump_app
     from tribodem.dem.cli import bench_app, dem_app
+    from tribodem.fretting.cli import fretting_app
+    from tribodem.materials.cli import calibrate
 
     app.add_typer(dem_app, name="dem")
     app.add_typer(bench_app, name="bench")
     app.add_typer(jump_app, name="jump")
+    app.add_typer(fretting_app, name="fretting")
+    app.command("calibrate")(calibrate)
+    app.add_typer(braking_app, name="braking")
 
 
 _register()

@@ -1,0 +1,149 @@
+"""Braking interface model (seed 000 sections 3.2-5, table 4)."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from tribodem.braking.conditions import (
+    CONDITIONS,
+    FRICTION_RADIUS_M,
+    PAD_AREA_M2,
+    get_condition,
+    load_to_pressure,
+    pressure_to_load,
+    rpm_to_speed,
+    speed_to_rpm,
+)
+from tribodem.braking.measure import classify, measure, reference
+from tribodem.braking.model import DISC, PAD, Geometry, build_interface, start_sliding
+from tribodem.braking.run import RunSetup, run_braking, wear_extrapolation
+from tribodem.dem.state import FIX_X, FIX_Y
+
+SMALL = Geometry(width=100e-6, disc_height=36e-6, pad_height=36e-6, amplitude=4e-6, modes=2,
+                 seed=3)
+REQUIRED = ("condition", "pressure_Pa", "sliding_speed_m_s", "simulated_sliding_distance_m",
+            "simulated_time_s", "equivalent_braking_time_s", "wear_depth_mean_m",
+            "wear_depth_max_m", "broken_bonds", "broken_bonds_tensile", "broken_bonds_shear",
+            "debris_particles", "force_chains", "strong_force_chains",
+            "transfer_layer_thickness_m", "particles_initial", "particles_final")
+
+
+def test_table4_conversions() -> None:
+    assert load_to_pressure(13.0) == pytest.approx(0.33e6, rel=1e-9)
+    for c in CONDITIONS.values():  # every row of table 4 after the table's rounding
+        assert round(c.pressure_Pa / 1e6, 2) == c.table_pressure_MPa
+        assert c.speed_m_s == pytest.approx(c.table_speed_m_s, abs=0.01)
+    assert rpm_to_speed(1200) == pytest.approx(47.12, abs=0.005)
+    assert rpm_to_speed(800) == pytest.approx(31.416, abs=1e-3)
+    assert PAD_AREA_M2 == pytest.approx(0.03939, rel=1e-3) and FRICTION_RADIUS_M == 0.375
+    assert pressure_to_load(load_to_pressure(17.0)) == pytest.approx(17.0)
+    assert speed_to_rpm(rpm_to_speed(1000.0)) == pytest.approx(1000.0)
+    with pytest.raises(ValueError, match=r"condition = 6: must be one of \[1, 2, 3, 4, 5\]"):
+        get_condition(6)
+    with pytest.raises(ValueError, match="load_kN"):
+        load_to_pressure(-1.0)
+
+
+def test_interface_geometry_and_boundary_conditions() -> None:
+    it = build_interface(SMALL, 0.33e6)
+    p = it.sim.p
+    disc, pad = p.group == DISC, p.group == PAD
+    assert disc.any() and pad.any() and it.sim.box.periodic[0]
+    # pad above disc, its lowest point a clearance above the disc's highest point
+    gap = (p.pos[pad, 1] - p.radius[pad]).min() - (p.pos[disc, 1] + p.radius[disc]).max()
+    assert gap == pytest.approx(SMALL.clearance, abs=1e-12)
+    # rough: the outer surfaces vary by more than one particle diameter along x
+    assert np.ptp(p.pos[disc, 1][np.argsort(p.pos[disc, 1])[-10:]]) > 0
+    assert np.all(p.fixed[it.anchor_disc] & (FIX_X | FIX_Y) == (FIX_X | FIX_Y))
+    assert np.all(p.fixed[it.anchor_pad] & FIX_X) and not np.any(p.fixed[it.anchor_pad] & FIX_Y)
+    assert it.anchor_disc.sum() >= 5 and it.anchor_pad.sum() >= 5
+    # bonds only inside each body; the target force is p W t
+    b = it.bonds
+    assert np.all(p.group[b.i] == p.group[b.j])
+    assert it.target_force == pytest.approx(0.33e6 * SMALL.width * 1.0)
+    matrix, _ = classify(it)
+    assert matrix.all()  # intact: everything is matrix
+    start_sliding(it, 30.0)
+    assert np.all(p.vel[disc, 0] == -30.0) and np.all(p.vel[pad, 0] == 0.0)
+    ref = reference(it)
+    it.sim.step(100)
+    m = measure(it, ref, 30.0 * it.sim.time)
+    assert m["debris_particles"] == 0 and m["wear_depth_mean_m"] == 0.0
+    assert m["force_chains"] >= 0.9 * b.n_bonds  # every loaded intact bond is a chain
+    with pytest.raises(ValueError, match="width"):
+        build_interface(Geometry(width=1e-6), 0.33e6)
+
+
+@pytest.fixture(scope="module")
+def quick_run(tmp_path_factory: pytest.TempPathFactory) -> tuple[dict, Path]:
+    out = tmp_path_factory.mktemp("braking")
+    setup = RunSetup(pressure_Pa=0.53e6, speed_m_s=47.12, duration_s=4e-6, geometry=SMALL,
+                     condition=5, samples=40, vtk_snapshots=2)
+    return run_braking(setup, out), out
+
+
+def test_quick_run_conserves_particles_and_accounts_debris(quick_run: tuple[dict, Path]
+                                                           ) -> None:
+    s, out = quick_run
+    assert s["particles_final"] == s["particles_initial"] > 100
+    assert s["matrix_particles"] + s["debris_particles"] == s["particles_initial"]
+    assert s["debris_particles"] == s["debris_particles_disc"] + s["debris_particles_pad"]
+    assert s["broken_bonds"] > 0  # asperities at 47 m/s do break bonds
+    assert s["broken_bonds"] == s["broken_bonds_tensile"] + s["broken_bonds_shear"]
+    assert s["strong_force_chains"] + s["weak_force_chains"] == s["force_chains"]
+    assert s["simulated_sliding_distance_m"] == pytest.approx(47.12 * s["simulated_time_s"])
+    ts = np.genfromtxt(out / "timeseries.csv", delimiter=",", names=True)
+    assert np.all(np.diff(ts["broken_bonds"]) >= 0)  # bonds never heal
+    assert np.all(ts["matrix_particles"] + ts["debris_particles"] == s["particles_initial"])
+    assert ts["wear_depth_mean_m"][0] == 0.0
+
+
+def test_pressure_wall_holds_target_on_average(quick_run: tuple[dict, Path]) -> None:
+    s, _ = quick_run
+    assert s["mean_wall_pressure_ratio"] == pytest.approx(1.0, abs=0.05)
+    assert s["mean_wall_pressure_Pa"] == pytest.approx(0.53e6, rel=0.05)
+
+
+def test_summary_keys_and_outputs(quick_run: tuple[dict, Path]) -> None:
+    s, out = quick_run
+    on_disk = json.loads((out / "summary.json").read_text())
+    for k in REQUIRED:
+        assert k in on_disk, k
+    assert on_disk["condition"] == 5 and on_disk["equivalent_braking_time_s"] > 0
+    for f in ("displacement.png", "velocity.png", "force_chains.png", "wear_history.png",
+              "vtk/particles.pvd", "vtk/chains.pvd"):
+        assert (out / f).stat().st_size > 0, f
+    assert any("time mapping" in a for a in on_disk["assumptions"])
+
+
+def test_wear_extrapolation_rule() -> None:
+    t = np.linspace(0, 1e-5, 11)
+    rate, h8 = wear_extrapolation(t, 2.0 * t, 8.0)
+    assert rate == pytest.approx(2.0) and h8 == pytest.approx(16.0)
+
+
+def _cli(*args: str) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "tribodem.cli", "braking", *args],
+                          capture_output=True, text=True, timeout=120)
+
+
+def test_cli_refuses_bad_input(tmp_path: Path) -> None:
+    r = _cli("run", "--condition", "7", "--out", str(tmp_path / "x"))
+    assert r.returncode == 2 and "condition" in r.stderr and "Traceback" not in r.stderr
+    assert not (tmp_path / "x").exists()
+    bad = tmp_path / "bad.toml"
+    bad.write_text("[geometry]\nwidth_m = -1.0\n")
+    r = _cli("run", "--config", str(bad), "--out", str(tmp_path / "y"))
+    assert r.returncode == 2 and "width_m" in r.stderr
+    bad.write_text("[condition]\nindex = 1\n[geometry]\nwidth_m = 1e-6\n")  # too narrow
+    r = _cli("run", "--config", str(bad), "--out", str(tmp_path / "w"))
+    assert r.returncode == 2 and "width" in r.stderr and "Traceback" not in r.stderr
+    bad.write_text("[condition]\nload_kN = 13.0\n")  # no speed
+    r = _cli("run", "--config", str(bad), "--out", str(tmp_path / "z"))
+    assert r.returncode == 2 and "speed" in r.stderr

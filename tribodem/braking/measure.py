@@ -1,0 +1,170 @@
+"""Measurements of the braking interface (seed 000 sections 3.4 and 5), all frame-free.
+
+Definitions (reference state = the loaded interface at the start of sliding):
+
+- **matrix / debris**: the graph of intact bonds is split into connected components
+  (scipy.sparse.csgraph); a component holding an anchored particle (disc bottom layer,
+  pad top layer) is the body's *matrix*; every other particle is *detached* = *debris*.
+  Each particle is exactly one of the two. *Debris clusters* are the debris components
+  (a lone particle is a cluster of one; ``debris_clusters_multi`` counts those of >= 2).
+  Bonds never re-form, so detachment is irreversible.
+- **worn** particles: detached particles displaced by more than one mean radius from
+  their place in their body's frame (the disc's rigid sliding removed): material that
+  left the surface, not a cracked grain still in its seat.
+- **wear depth, mean** (per body): the solid area of the body's worn particles over
+  the cell width and the packing fraction, ``h = sum(pi r^2) / (phi W)`` (m): the
+  thickness of intact material removed, the area form of "vertical displacement of the
+  detached material" (section 3.4). The seed's pad value is ``wear_depth_mean_m``.
+- **wear depth, max** (per body): the deepest initial position of a worn particle's
+  far edge below the body's initial mean surface (disc: ``s0 - (y0 - r)``; pad:
+  ``(y0 + r) - s0``), clipped at 0; ``s0`` = mean over x-bins (2 r_max wide) of the
+  outermost particle surface of the body.
+- **wear range** (per body): deepest initial position (centre depth below ``s0`` of the
+  two ends) of a broken bond; ``wear_range_ratio`` = disc / pad (seed: 1:3).
+- **force chains**: every particle pair carrying force: active contacts plus intact
+  bonds, summed per pair (PFC's contact + parallel bond); normal force + = compression;
+  *strong* = |F| above the mean |F| (section 3.1, figures 5, 17); *tensile* F < 0.
+- **transfer layer thickness**: debris solid area over ``phi W`` (m): the equivalent
+  thickness of the third-body layer between the matrices.
+- **debris vertical displacement**: max |y - y0| of debris particles (m), the quantity of
+  the seed's figures 11-12 displacement maps.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
+
+from tribodem.braking.model import DISC, PAD, Interface
+
+
+@dataclass
+class Reference:
+    """The reference state of the measurements (start of sliding)."""
+
+    pos: np.ndarray
+    radius: np.ndarray
+    group: np.ndarray
+    surface: dict[int, float]
+    phi: dict[int, float]
+    width: float
+
+    def depth(self, idx: np.ndarray, edge: bool) -> np.ndarray:
+        """Initial depth (m) of particles ``idx`` below their body's mean surface: of the
+        far edge (``edge``) or the centre."""
+        y = self.pos[idx, 1]
+        r = self.radius[idx] if edge else 0.0
+        g = self.group[idx]
+        return np.where(g == DISC, self.surface[DISC] - (y - r), (y + r) - self.surface[PAD])
+
+
+def mean_surface(pos: np.ndarray, radius: np.ndarray, group: np.ndarray, body: int,
+                 width: float) -> float:
+    """Mean over x-bins (2 r_max wide) of the body's outermost particle surface (m)."""
+    sel = group == body
+    nb = max(1, int(width // (2.0 * float(radius.max()))))
+    b = np.minimum((np.mod(pos[sel, 0], width) / width * nb).astype(int), nb - 1)
+    if body == DISC:
+        top = np.full(nb, -np.inf)
+        np.maximum.at(top, b, pos[sel, 1] + radius[sel])
+    else:
+        top = np.full(nb, np.inf)
+        np.minimum.at(top, b, pos[sel, 1] - radius[sel])
+    return float(top[np.isfinite(top)].mean())
+
+
+def reference(iface: Interface) -> Reference:
+    """Take the reference state now (call at the start of sliding)."""
+    p = iface.sim.p
+    w = iface.width
+    return Reference(pos=p.pos.copy(), radius=p.radius.copy(), group=p.group.copy(),
+                     surface={b: mean_surface(p.pos, p.radius, p.group, b, w)
+                              for b in (DISC, PAD)},
+                     phi=dict(iface.phi), width=w)
+
+
+def classify(iface: Interface) -> tuple[np.ndarray, np.ndarray]:
+    """(matrix mask, component label per particle) from the intact-bond graph."""
+    n = iface.sim.p.n
+    b = iface.bonds
+    ok = b.intact
+    g = coo_matrix((np.ones(int(ok.sum())), (b.i[ok], b.j[ok])), shape=(n, n))
+    _, lab = connected_components(g, directed=False)
+    anchored = np.zeros(lab.max() + 1, dtype=bool)
+    anchored[lab[iface.anchors]] = True
+    return anchored[lab], lab
+
+
+def force_chains(iface: Interface) -> dict[str, np.ndarray]:
+    """Pairs carrying force (contacts + intact bonds, summed per pair): i, j, normal force
+    (N, + compression)."""
+    sim = iface.sim
+    n = sim.p.n
+    c = sim.contacts()
+    b = iface.bonds
+    ok = b.intact
+    i = np.concatenate([c["i"], b.i[ok]]).astype(np.int64)
+    j = np.concatenate([c["j"], b.j[ok]]).astype(np.int64)
+    f = np.concatenate([c["normal_force"], b.fn[ok]])
+    lo, hi = np.minimum(i, j), np.maximum(i, j)
+    key, inv = np.unique(lo * n + hi, return_inverse=True)
+    fs = np.bincount(inv, weights=f, minlength=key.size)
+    keep = fs != 0.0
+    return {"i": (key // n)[keep], "j": (key % n)[keep], "force": fs[keep]}
+
+
+def measure(iface: Interface, ref: Reference, slid: float) -> dict[str, float]:
+    """All scalar measurements now (see the module docstring); ``slid``: the disc's
+    sliding distance since the reference (m). SI units."""
+    p = iface.sim.p
+    matrix, lab = classify(iface)
+    debris = ~matrix
+    u = p.pos - ref.pos
+    u[ref.group == DISC, 0] += slid
+    u[:, 0] -= ref.width * np.rint(u[:, 0] / ref.width)
+    worn = debris & (np.linalg.norm(u, axis=1) > float(ref.radius.mean()))
+    out: dict[str, float] = {}
+    area = np.pi * ref.radius**2
+    w = ref.width
+    for body, name in ((DISC, "disc"), (PAD, "pad")):
+        d = worn & (ref.group == body)
+        out[f"worn_particles_{name}"] = float(d.sum())
+        out[f"debris_particles_{name}"] = float((debris & (ref.group == body)).sum())
+        out[f"wear_depth_mean_{name}_m"] = float(area[d].sum() / (ref.phi[body] * w))
+        dep = ref.depth(np.flatnonzero(d), edge=True)
+        out[f"wear_depth_max_{name}_m"] = float(max(0.0, dep.max(initial=0.0)))
+    b = iface.bonds
+    broken = ~b.intact
+    for body, name in ((DISC, "disc"), (PAD, "pad")):
+        sel = broken & (ref.group[b.i] == body)
+        dep = 0.5 * (ref.depth(b.i[sel], edge=False) + ref.depth(b.j[sel], edge=False))
+        out[f"wear_range_{name}_m"] = float(max(0.0, dep.max(initial=0.0)))
+    out["wear_range_ratio"] = (out["wear_range_disc_m"] / out["wear_range_pad_m"]
+                               if out["wear_range_pad_m"] > 0 else float("nan"))
+    out["wear_depth_mean_m"] = out["wear_depth_mean_pad_m"]
+    out["wear_depth_max_m"] = out["wear_depth_max_pad_m"]
+    out["broken_bonds"] = float(b.broken_count())
+    out["broken_bonds_tensile"] = float(b.broken_count("tensile"))
+    out["broken_bonds_shear"] = float(b.broken_count("shear"))
+    out["debris_particles"] = float(debris.sum())
+    out["matrix_particles"] = float(matrix.sum())
+    dl = lab[debris]
+    sizes = np.bincount(dl) if dl.size else np.zeros(0, dtype=int)
+    out["debris_clusters"] = float(np.count_nonzero(sizes))
+    out["debris_clusters_multi"] = float(np.count_nonzero(sizes >= 2))
+    phi_m = 0.5 * (ref.phi[DISC] + ref.phi[PAD])
+    out["transfer_layer_thickness_m"] = float(area[debris].sum() / (phi_m * w))
+    out["debris_max_vertical_displacement_m"] = float(
+        np.abs(p.pos[debris, 1] - ref.pos[debris, 1]).max(initial=0.0))
+    ch = force_chains(iface)
+    f = ch["force"]
+    mag = np.abs(f)
+    out["force_chains"] = float(f.size)
+    out["strong_force_chains"] = float(np.count_nonzero(mag > mag.mean())) if f.size else 0.0
+    out["weak_force_chains"] = out["force_chains"] - out["strong_force_chains"]
+    out["tensile_force_chains"] = float(np.count_nonzero(f < 0))
+    out["compressive_force_chains"] = float(np.count_nonzero(f > 0))
+    return out

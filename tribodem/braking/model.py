@@ -1,0 +1,344 @@
+"""The braking interface of seed 000 section 3.2 / figure 8, built on ``tribodem.dem``.
+
+Geometry: one bonded-particle block compacted in a box periodic in x (walls at its bottom
+and top, isotropic stress ``compaction_stress`` as in section 3.1), cut along two random
+surface profiles into a disc (Q345B, group 1, below) and a pad (Cu-PM, group 2, above):
+particles between the profiles are removed, so both surfaces carry asperities and pits;
+the pad is then placed with its lowest point ``clearance`` above the disc's highest point:
+braking starts by applying the pad to the already sliding disc, the pressure plate
+brings it down, and the asperities meet tip first. Parallel bonds join
+every same-body pair with surface gap below the bond gap (section 3.1); the bodies are
+not bonded to each other.
+
+Boundary conditions (figure 8):
+- periodic in x (figure 7 remapping);
+- disc: the particles within one mean diameter of its bottom are anchored (FIX_X | FIX_Y):
+  fixed in y (the disc's "pressure wall") and, while sliding, driven in -x at the sliding
+  speed (PFC applies the disc's linear speed to its particles; the rest of the disc starts
+  at the same velocity and follows through bonds and contacts);
+- pad: the particles within one mean diameter of its top are held in x (the support wall,
+  FIX_X, vx = 0) and pressed in -y by a pressure wall with the target force ``p W t``
+  (pressure x cell width x disk thickness, 2D unit thickness): a ``PlaneWall`` in the
+  engine's ``"boundary"`` servo mode (``M a = F_target - F_wall``, seed 003 eq 3.6) with a
+  small mass ``wall_mass_ratio`` x the pad slab mass and no damping, so its time-mean
+  force is the target (PFC's gain servo cannot follow the pad after 47 m/s asperity
+  impacts; see docs/braking.md);
+- optional uniform temperature boundary from a curve (section 3.2 eq 13, figure 9).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from tribodem.dem import Box, Material, ParallelBonds, ParticleState, PlaneWall, Simulation
+from tribodem.dem.state import FIX_X, FIX_Y
+from tribodem.materials.library import CU_PM, Q345B, MaterialSpec
+
+DISC, PAD = 1, 2  # particle groups
+PHI0 = 0.35  # area fraction of the random placement
+PHI_TARGET = 0.82  # area fraction of the particle count before the stress adjustment
+MASS_SCALE = 1.0e4  # density multiplier during compaction only (geometry only is kept)
+
+#: micro-parameters (E_c Pa, kratio) from ``tribodem calibrate`` (full, 8 specimens), see
+#: docs/braking.md "Results": table 1 E and nu within 1.1% in tribodem's assembly
+CALIBRATED = {"q345b": (1.99e11, 1.23), "cu-pm": (1.75e11, 1.20)}
+
+
+def materials(micro: str = "calibrated") -> tuple[MaterialSpec, MaterialSpec]:
+    """(disc, pad) specs: ``"calibrated"`` (E_c, kratio of ``tribodem calibrate``) or
+    ``"table3"`` (the seed's table 3 values, uncalibrated in tribodem's assembly)."""
+    if micro == "table3":
+        return Q345B, CU_PM
+    if micro == "calibrated":
+        return (Q345B.with_micro(*CALIBRATED["q345b"]), CU_PM.with_micro(*CALIBRATED["cu-pm"]))
+    raise ValueError(f"micro = {micro!r}: must be 'calibrated' or 'table3'")
+
+
+@dataclass
+class Geometry:
+    """Sizes (m) of the interface cell: periodic ``width``, disc and pad heights,
+    roughness ``amplitude`` (max |profile|) with ``modes`` sine modes of wavelengths
+    W/1..W/modes, packing ``seed``. Start: the pad's lowest point ``clearance`` above the
+    disc's highest point (the pad is applied to the sliding disc), ``compaction_stress``
+    (Pa) of the packing."""
+
+    width: float = 360e-6
+    disc_height: float = 100e-6
+    pad_height: float = 100e-6
+    amplitude: float = 10e-6
+    modes: int = 4
+    clearance: float = 5e-8
+    seed: int = 0
+    compaction_stress: float = 1.0e6
+
+    def check(self, rmax: float) -> None:
+        """Refuse sizes the model cannot use (ValueError naming the field)."""
+        for name in ("width", "disc_height", "pad_height"):
+            v = getattr(self, name)
+            if not v >= 8 * rmax:
+                raise ValueError(f"geometry: {name} = {v!r} m: must be >= 8 x the largest "
+                                 f"radius ({8 * rmax:.3g} m)")
+        if not 0 <= self.amplitude <= 0.3 * min(self.disc_height, self.pad_height):
+            raise ValueError(f"geometry: amplitude = {self.amplitude!r} m: must be in "
+                             "[0, 0.3 x the smaller body height]")
+        if not 1 <= self.modes <= 64:
+            raise ValueError(f"geometry: modes = {self.modes!r}: must be in [1, 64]")
+        if not self.clearance >= 0:
+            raise ValueError(f"geometry: clearance = {self.clearance!r} m: must be >= 0")
+
+
+@dataclass
+class Interface:
+    """A built interface: the simulation, its bonds and the pressure wall, plus the
+    bookkeeping the measurements need (groups, anchors, packing fraction)."""
+
+    sim: Simulation
+    bonds: ParallelBonds
+    wall: PlaneWall
+    disc: MaterialSpec
+    pad: MaterialSpec
+    geometry: Geometry
+    anchor_disc: np.ndarray
+    anchor_pad: np.ndarray
+    phi: dict[int, float]
+    target_force: float
+    stats: dict[str, float] = field(default_factory=dict)
+
+    @property
+    def width(self) -> float:
+        """Periodic cell width (m)."""
+        return float(self.sim.box.length[0])
+
+    @property
+    def anchors(self) -> np.ndarray:
+        """Mask of the anchored particles (disc bottom layer and pad top layer)."""
+        return self.anchor_disc | self.anchor_pad
+
+
+def _place_periodic(rng: np.random.Generator, radii: np.ndarray, w: float, h: float
+                    ) -> np.ndarray:
+    """Random sequential placement without overlap, periodic in x, in [0, w) x [r, h - r]."""
+    pos = np.zeros((radii.size, 3))
+    for k, r in enumerate(radii):
+        for _ in range(20_000):
+            x = rng.uniform(0.0, w)
+            y = rng.uniform(r, h - r)
+            dx = pos[:k, 0] - x
+            dx -= w * np.rint(dx / w)
+            if np.all(dx * dx + (pos[:k, 1] - y) ** 2 > (radii[:k] + r) ** 2):
+                break
+        else:
+            raise RuntimeError(f"interface: could not place particle {k} of {radii.size}")
+        pos[k, 0], pos[k, 1] = x, y
+    return pos
+
+
+def compact_periodic(spec: MaterialSpec, width: float, height: float, seed: int,
+                     stress: float = 1.0e6, max_iter: int = 40
+                     ) -> tuple[np.ndarray, np.ndarray, dict[str, float]]:
+    """A dense packing periodic in x between two walls (y = 0, y = ``height``): random
+    placement, radius expansion in 10 stages, then a uniform radius scale (bracketing
+    bisection) until the mean wall stress is within a factor 2 of ``stress`` (Pa; section
+    3.1, PFC's isotropic-stress installation). Frictionless, mass-scaled, local damping
+    0.7. Returns (pos, radii, stats)."""
+    rng = np.random.default_rng(seed)
+    rmin, rmax = spec.radius_range
+    mean_area = math.pi * (rmin * rmin + rmin * rmax + rmax * rmax) / 3.0
+    n = int(round(PHI_TARGET * width * height / mean_area))
+    radii = np.sort(rng.uniform(rmin, rmax, size=n))[::-1].copy()
+    f0 = math.sqrt(PHI0 / PHI_TARGET)
+    pos = _place_periodic(rng, radii * f0, width, height)
+    t = spec.thickness
+    mat = Material(name="compaction", young=spec.young, poisson=spec.poisson,
+                   density=spec.density * MASS_SCALE, friction=0.0,
+                   effective_modulus=spec.effective_modulus, kratio=1.0, beta_n=spec.beta_n,
+                   law="linear")
+    box = Box([0.0, -2 * rmax, 0.0], [width, height + 2 * rmax, 0.0], [True, False, False])
+
+    def relax(pos: np.ndarray, r: np.ndarray, steps: int) -> tuple[np.ndarray, float]:
+        walls = [PlaneWall([0, 0, 0], [0, 1, 0], name="bottom"),
+                 PlaneWall([0, height, 0], [0, -1, 0], name="top")]
+        part = ParticleState(dim=2, pos=pos, radius=r, density=mat.density, thickness=t)
+        sim = Simulation(part, [mat], box, walls=walls, local_damping=0.7, dt_safety=0.2)
+        sim.step(steps)
+        sig = 0.5 * (walls[0].normal_force + walls[1].normal_force) / (width * t)
+        return sim.p.pos.copy(), sig
+
+    sig = 0.0
+    for f in np.linspace(f0, 1.0, 10)[1:]:
+        pos, sig = relax(pos, radii * f, 300)
+    lo: float | None = None
+    hi: tuple[float, np.ndarray] | None = None
+    alpha, start, n_iter = 1.0, pos, 0
+    for _ in range(max_iter):
+        n_iter += 1
+        pos, sig = relax(start, radii * alpha, 600)
+        if 0.5 * stress <= sig <= 2.0 * stress:
+            break
+        if sig > 2.0 * stress:
+            hi = (alpha, pos)
+        else:
+            lo = alpha
+        if lo is not None and hi is not None:
+            alpha = 0.5 * (lo + hi[0])
+        elif hi is not None:
+            alpha = hi[0] * (1.0 - min(sig / spec.effective_modulus, 0.02))
+        else:
+            alpha *= 1.004
+        start = pos if hi is None else hi[1]
+    else:
+        if hi is not None:
+            alpha, pos = hi[0], hi[1]
+    return pos, radii * alpha, {"compaction_iterations": float(n_iter),
+                                "compaction_stress_Pa": float(sig),
+                                "radius_scale": float(alpha), "generated": float(n)}
+
+
+def rough_profile(rng: np.random.Generator, width: float, amplitude: float, modes: int
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A random periodic profile: sine modes k = 1..modes (wavelength W/k), amplitudes
+    U(0.3, 1)/k, random phases, scaled so max |h| = ``amplitude``. Returns
+    (k, amplitude per mode, phase per mode) for ``profile_height``."""
+    k = np.arange(1, modes + 1, dtype=float)
+    a = rng.uniform(0.3, 1.0, size=modes) / k
+    ph = rng.uniform(0.0, 2.0 * math.pi, size=modes)
+    x = np.linspace(0.0, width, 2049)
+    h = (a[None, :] * np.sin(2 * math.pi * k[None, :] * x[:, None] / width + ph)).sum(axis=1)
+    scale = amplitude / max(float(np.abs(h).max()), 1e-300)
+    return k, a * scale, ph
+
+
+def profile_height(x: np.ndarray, width: float, prof: tuple[np.ndarray, ...]) -> np.ndarray:
+    """Height (m) of a ``rough_profile`` at ``x`` (m)."""
+    k, a, ph = prof
+    return (a[None, :] * np.sin(2 * math.pi * k[None, :] * np.asarray(x)[:, None] / width
+                                + ph)).sum(axis=1)
+
+
+def _pairs_periodic(pos: np.ndarray, radius: np.ndarray, width: float, gap: float
+                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Pairs (i < j) with surface gap < ``gap`` (m), periodic in x; returns (i, j, gap)."""
+    y0 = pos[:, 1].min()
+    span = float(np.ptp(pos[:, 1])) + 10 * float(radius.max()) + 1.0
+    pts = np.stack([np.mod(pos[:, 0], width), pos[:, 1] - y0 + 1e-9], axis=1)
+    tree = cKDTree(pts, boxsize=[width, span])
+    pairs = tree.query_pairs(2.0 * float(radius.max()) + max(gap, 0.0) + 1e-12,
+                             output_type="ndarray")
+    if pairs.size == 0:
+        z = np.zeros(0, dtype=np.int64)
+        return z, z.copy(), np.zeros(0)
+    i, j = pairs[:, 0].astype(np.int64), pairs[:, 1].astype(np.int64)
+    d = pos[j, :2] - pos[i, :2]
+    d[:, 0] -= width * np.rint(d[:, 0] / width)
+    g = np.linalg.norm(d, axis=1) - radius[i] - radius[j]
+    keep = g < gap
+    return i[keep], j[keep], g[keep]
+
+
+def build_interface(geometry: Geometry, pressure_Pa: float, micro: str = "calibrated",
+                    wall_mass_ratio: float = 0.05, dt_safety: float = 0.3,
+                    local_damping: float = 0.0) -> Interface:
+    """Build the figure 8 interface (see the module docstring) with the pressure target
+    ``pressure_Pa x width x thickness`` (N). Particles start at rest; ``start_sliding``
+    sets the disc moving, the pressure plate then applies the pad."""
+    if not pressure_Pa > 0:
+        raise ValueError(f"pressure_Pa = {pressure_Pa!r}: must be > 0 Pa")
+    if not 0 < wall_mass_ratio <= 10:
+        raise ValueError(f"wall_mass_ratio = {wall_mass_ratio!r}: must be in (0, 10]")
+    disc, pad = materials(micro)
+    rmax = max(disc.radius_range[1], pad.radius_range[1])
+    geometry.check(rmax)
+    g = geometry
+    w = g.width
+    total = g.disc_height + g.pad_height + 2.0 * g.amplitude
+    # one block, compacted with the disc's stiffness (both materials differ by ~12% in E_c;
+    # the packing geometry only is kept)
+    pos, radii, stats = compact_periodic(disc, w, total, g.seed, g.compaction_stress)
+    phi_c = float(math.pi * (radii**2).sum() / (w * total))
+    rng = np.random.default_rng(g.seed + 7919)
+    prof_d = rough_profile(rng, w, g.amplitude, g.modes)
+    prof_p = rough_profile(rng, w, g.amplitude, g.modes)
+    x, y = pos[:, 0], pos[:, 1]
+    y_mid = g.disc_height + g.amplitude
+    hd = y_mid + profile_height(x, w, prof_d)
+    xs = np.linspace(0.0, w, 2049)
+    lift = float((profile_height(xs, w, prof_d) - profile_height(xs, w, prof_p)).max())
+    hp = y_mid + lift + profile_height(x, w, prof_p)
+    is_disc = y < hd
+    is_pad = y > hp
+    keep = is_disc | is_pad
+    pos, radii, is_pad = pos[keep], radii[keep], is_pad[keep]
+    group = np.where(is_pad, PAD, DISC).astype(np.int32)
+    # bonds: same-body pairs within the bond gap (section 3.1); bodies not bonded together
+    bi, bj, _ = _pairs_periodic(pos, radii, w, max(disc.bond_gap, pad.bond_gap))
+    same = group[bi] == group[bj]
+    bi, bj = bi[same], bj[same]
+    # drop particles without a bond (floaters of the cut)
+    deg = np.bincount(np.concatenate([bi, bj]), minlength=radii.size)
+    ok = deg > 0
+    idx = np.cumsum(ok) - 1
+    keep2 = ok[bi] & ok[bj]
+    bi, bj = idx[bi[keep2]], idx[bj[keep2]]
+    pos, radii, group = pos[ok], radii[ok], group[ok]
+    # pad down rigidly until the closest disc-pad surface gap is the clearance
+    pd = group == PAD
+    # braking starts with the pad applied to the already sliding disc: its lowest point a
+    # clearance above the disc's highest point
+    gap = float((pos[pd, 1] - radii[pd]).min() - (pos[~pd, 1] + radii[~pd]).max())
+    pos[pd, 1] -= gap - g.clearance
+    # anchors: one mean diameter from the outer faces
+    dm = 2.0 * float(radii.mean())
+    bottom = float((pos[~pd, 1] - radii[~pd]).min())
+    top = float((pos[pd, 1] + radii[pd]).max())
+    anchor_disc = (~pd) & (pos[:, 1] - radii < bottom + dm)
+    anchor_pad = pd & (pos[:, 1] + radii > top - dm)
+    fixed = np.where(anchor_disc, FIX_X | FIX_Y, 0) | np.where(anchor_pad, FIX_X, 0)
+    dens = np.where(pd, pad.density, disc.density)
+    part = ParticleState(dim=2, pos=pos, radius=radii, density=dens, thickness=disc.thickness,
+                         mat=np.where(pd, 1, 0), group=group, fixed=fixed)
+    target = pressure_Pa * w * disc.thickness
+    pad_mass = float((dens[pd] * math.pi * radii[pd] ** 2).sum() * disc.thickness)
+    wall = PlaneWall([0.0, top, 0.0], [0.0, -1.0, 0.0], material=1, mode="boundary",
+                     target_force=target, servo_mass=wall_mass_ratio * pad_mass,
+                     name="pressure")
+    margin = 4.0 * rmax + 2.0 * g.amplitude
+    box = Box([0.0, bottom - margin, 0.0], [w, top + margin, 0.0], [True, False, False])
+    sim = Simulation(part, [disc.contact_material(), pad.contact_material()], box,
+                     walls=[wall], dt_safety=dt_safety, local_damping=local_damping)
+    on_pad = group[bi] == PAD
+    pick = lambda a, b: np.where(on_pad, b, a)  # noqa: E731
+    bonds = ParallelBonds(sim, bi, bj, disc.bond_lambda,
+                          pick(disc.bond_E, pad.bond_E), pick(disc.bond_kr, pad.bond_kr),
+                          pick(disc.tensile_strength, pad.tensile_strength),
+                          pick(disc.cohesion, pad.cohesion))
+    sim.add_interaction(bonds)
+    stats.update({"removed_by_cut": float(keep.size - keep.sum() + (~ok).sum()),
+                  "particles": float(part.n), "bonds": float(bonds.n_bonds),
+                  "bonds_per_particle": 2.0 * bonds.n_bonds / part.n,
+                  "profile_lift_m": lift, "packing_fraction": phi_c})
+    phi = {DISC: phi_c, PAD: phi_c}
+    return Interface(sim=sim, bonds=bonds, wall=wall, disc=disc, pad=pad, geometry=g,
+                     anchor_disc=anchor_disc, anchor_pad=anchor_pad, phi=phi,
+                     target_force=target, stats=stats)
+
+
+def cross_contacts(iface: Interface) -> int:
+    """Active disc-pad contacts (N > 0) between particles of the two bodies' groups."""
+    c = iface.sim.contacts()
+    g = iface.sim.p.group
+    return int(np.count_nonzero((g[c["i"]] != g[c["j"]]) & (c["normal_force"] > 0)))
+
+
+def start_sliding(iface: Interface, speed_m_s: float) -> None:
+    """Set the disc moving in -x at ``speed_m_s`` (its anchored bottom layer keeps it)."""
+    if not speed_m_s > 0:
+        raise ValueError(f"speed_m_s = {speed_m_s!r}: must be > 0 m/s")
+    p = iface.sim.p
+    d = p.group == DISC
+    p.vel[d, 0] = -speed_m_s
+    p.vel[iface.anchor_disc, 1] = 0.0
+    p.vel[iface.anchor_pad, 0] = 0.0
