@@ -19,7 +19,7 @@ import typer
 
 from tribodem.cyclejump import STRATEGIES, ReplayResult, make_strategy, replay
 from tribodem.io.config import ConfigError
-from tribodem.io.results import atomic_write
+from tribodem.io.results import write_figure
 
 jump_app = typer.Typer(
     help="Cycle-jumping strategies (seed 003 chapter 4): replay a recorded series.",
@@ -168,13 +168,7 @@ def plot_replay(result: ReplayResult, path: str | Path) -> Path:
     ax2.set_ylabel("rel. difference (%)")
     fig.tight_layout()
 
-    def write(tmp: Path) -> None:
-        fig.savefig(tmp, dpi=120, format="png")
-
-    try:
-        return atomic_write(path, write)
-    finally:
-        plt.close(fig)
+    return write_figure(path, fig)
 
 
 @jump_app.callback()

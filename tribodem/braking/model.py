@@ -37,6 +37,7 @@ from scipy.spatial import cKDTree
 from tribodem.dem import Box, Material, ParallelBonds, ParticleState, PlaneWall, Simulation
 from tribodem.dem.state import FIX_X, FIX_Y
 from tribodem.materials.library import CU_PM, Q345B, MaterialSpec
+from tribodem.materials.specimen import compact_by_radius_scaling
 
 DISC, PAD = 1, 2  # particle groups
 PHI0 = 0.35  # area fraction of the random placement
@@ -168,31 +169,8 @@ def compact_periodic(spec: MaterialSpec, width: float, height: float, seed: int,
         sig = 0.5 * (walls[0].normal_force + walls[1].normal_force) / (width * t)
         return sim.p.pos.copy(), sig
 
-    sig = 0.0
-    for f in np.linspace(f0, 1.0, 10)[1:]:
-        pos, sig = relax(pos, radii * f, 300)
-    lo: float | None = None
-    hi: tuple[float, np.ndarray] | None = None
-    alpha, start, n_iter = 1.0, pos, 0
-    for _ in range(max_iter):
-        n_iter += 1
-        pos, sig = relax(start, radii * alpha, 600)
-        if 0.5 * stress <= sig <= 2.0 * stress:
-            break
-        if sig > 2.0 * stress:
-            hi = (alpha, pos)
-        else:
-            lo = alpha
-        if lo is not None and hi is not None:
-            alpha = 0.5 * (lo + hi[0])
-        elif hi is not None:
-            alpha = hi[0] * (1.0 - min(sig / spec.effective_modulus, 0.02))
-        else:
-            alpha *= 1.004
-        start = pos if hi is None else hi[1]
-    else:
-        if hi is not None:
-            alpha, pos = hi[0], hi[1]
+    pos, alpha, sig, n_iter = compact_by_radius_scaling(
+        relax, pos, radii, f0, stress, spec.effective_modulus, max_iter, growth=1.004)
     return pos, radii * alpha, {"compaction_iterations": float(n_iter),
                                 "compaction_stress_Pa": float(sig),
                                 "radius_scale": float(alpha), "generated": float(n)}

@@ -8,6 +8,7 @@ from typing import Any
 import numpy as np
 
 from tribodem.braking.model import Interface
+from tribodem.io.results import write_figure
 
 
 def _plt():  # noqa: ANN202
@@ -55,8 +56,7 @@ def plot_run(out: Path, rows: list[dict[str, float]], frames: dict[str, dict[str
         ax.set_title(f"{k}: sliding {float(fr['slid']) * 1e6:.1f} um")
         ax.legend(loc="upper right", fontsize=7)
     fig.tight_layout()
-    fig.savefig(out / "displacement.png", dpi=120)
-    plt.close(fig)
+    write_figure(out / "displacement.png", fig)
     # velocity vectors (fig 13), disc frame-free: lab velocities
     fr = frames["end"]
     pos = fr["pos"].copy()
@@ -72,8 +72,7 @@ def plot_run(out: Path, rows: list[dict[str, float]], frames: dict[str, dict[str
     ax.set_ylabel("y (um)")
     ax.set_title("velocity vectors at the end (lab frame; disc at -v)")
     fig.tight_layout()
-    fig.savefig(out / "velocity.png", dpi=120)
-    plt.close(fig)
+    write_figure(out / "velocity.png", fig)
     # force chains (fig 17): black compression, red tension, width ~ |F|
     from matplotlib.collections import LineCollection
 
@@ -101,8 +100,7 @@ def plot_run(out: Path, rows: list[dict[str, float]], frames: dict[str, dict[str
                  f"weak (grey); {int((f > 0).sum())} comp., {int((f < 0).sum())} tens.",
                  fontsize=9)
     fig.tight_layout()
-    fig.savefig(out / "force_chains.png", dpi=120)
-    plt.close(fig)
+    write_figure(out / "force_chains.png", fig)
     # histories (figs 12, 18)
     t = np.array([r["time_s"] for r in rows]) * 1e6
     fig, axes = plt.subplots(2, 2, figsize=(10, 7))
@@ -134,5 +132,4 @@ def plot_run(out: Path, rows: list[dict[str, float]], frames: dict[str, dict[str
     fig.suptitle(f"condition {summary['condition']}: {summary['pressure_Pa'] / 1e6:.3g} MPa, "
                  f"{summary['sliding_speed_m_s']:.4g} m/s")
     fig.tight_layout()
-    fig.savefig(out / "wear_history.png", dpi=120)
-    plt.close(fig)
+    write_figure(out / "wear_history.png", fig)

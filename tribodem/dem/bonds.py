@@ -40,6 +40,7 @@ from numba import njit, prange
 from tribodem.dem import neighbors
 from tribodem.dem.jit import kernel
 from tribodem.dem.space import min_image
+from tribodem.dem.state import checked_per_item
 
 if TYPE_CHECKING:
     from tribodem.dem.engine import Simulation
@@ -243,16 +244,8 @@ def bond_csr(bi: np.ndarray, bj: np.ndarray, n: int) -> tuple[np.ndarray, np.nda
     return cstart, ids[order]
 
 
-def _per_bond(x: object, nb: int, name: str, allowed: str, ok: object) -> np.ndarray:
-    a = np.asarray(x, dtype=np.float64)
-    a = np.full(nb, float(a)) if a.ndim == 0 else a.reshape(-1).copy()
-    if a.shape != (nb,):
-        raise ValueError(f"bonds: {name} has shape {a.shape}, expected a scalar or ({nb},)")
-    bad = ~ok(a)  # type: ignore[operator]
-    if bad.any():
-        k = int(np.flatnonzero(bad)[0])
-        raise ValueError(f"bonds: {name} = {float(a[k])!r}: must be {allowed}")
-    return a
+def _per_bond(x: object, n: int, name: str, allowed: str, ok: object) -> np.ndarray:
+    return checked_per_item(x, n, "bonds", name, allowed, ok)
 
 
 class ParallelBonds:

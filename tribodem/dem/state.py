@@ -109,3 +109,18 @@ def _ints(x: np.ndarray | None, n: int, dtype: type) -> np.ndarray:
     if a.ndim == 0:
         return np.full(n, a, dtype=dtype)
     return a.astype(dtype).reshape(n).copy()
+
+
+def checked_per_item(x: object, n: int, room: str, name: str, allowed: str,
+                     ok: object) -> np.ndarray:
+    """A scalar or an (n,) array as a float array of n, every value passing ``ok``;
+    otherwise ValueError naming the room, the field, the value and what is allowed."""
+    a = np.asarray(x, dtype=np.float64)
+    a = np.full(n, float(a)) if a.ndim == 0 else a.reshape(-1).copy()
+    if a.shape != (n,):
+        raise ValueError(f"{room}: {name} has shape {a.shape}, expected a scalar or ({n},)")
+    bad = ~ok(a)  # type: ignore[operator]
+    if bad.any():
+        k = int(np.flatnonzero(bad)[0])
+        raise ValueError(f"{room}: {name} = {float(a[k])!r}: must be {allowed}")
+    return a

@@ -27,6 +27,7 @@ from numba import prange
 
 from tribodem.dem.bonds import INTACT, ParallelBonds
 from tribodem.dem.jit import kernel
+from tribodem.dem.state import checked_per_item
 
 if TYPE_CHECKING:
     from tribodem.dem.engine import Simulation
@@ -68,15 +69,7 @@ def read_curve(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _per_particle(x: object, n: int, name: str, allowed: str, ok: object) -> np.ndarray:
-    a = np.asarray(x, dtype=np.float64)
-    a = np.full(n, float(a)) if a.ndim == 0 else a.reshape(-1).copy()
-    if a.shape != (n,):
-        raise ValueError(f"thermal: {name} has shape {a.shape}, expected a scalar or ({n},)")
-    bad = ~ok(a)  # type: ignore[operator]
-    if bad.any():
-        k = int(np.flatnonzero(bad)[0])
-        raise ValueError(f"thermal: {name} = {float(a[k])!r}: must be {allowed}")
-    return a
+    return checked_per_item(x, n, "thermal", name, allowed, ok)
 
 
 class Thermal:

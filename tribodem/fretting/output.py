@@ -8,7 +8,7 @@ from typing import Any
 import numpy as np
 
 from tribodem.fretting.loop import RESULT_COLUMNS, FrettingHistory
-from tribodem.io.results import atomic_write, write_csv, write_json
+from tribodem.io.results import atomic_write, write_csv, write_figure, write_json
 
 
 def write_results(hist: FrettingHistory, out: Path, extra: dict[str, Any]) -> dict[str, Any]:
@@ -18,14 +18,6 @@ def write_results(hist: FrettingHistory, out: Path, extra: dict[str, Any]) -> di
     summary = {**hist.summary(), **extra}
     write_json(out / "summary.json", summary)
     return summary
-
-
-def _savefig(fig: Any, path: Path) -> Path:
-    import matplotlib.pyplot as plt
-
-    atomic_write(path, lambda p: fig.savefig(p, format="png", dpi=120))
-    plt.close(fig)
-    return path
 
 
 def _profile_rows(n_rows: int, k: int = 5) -> list[int]:
@@ -62,7 +54,7 @@ def write_figures(hist: FrettingHistory, out: Path) -> list[Path]:
         bottom.set_xlabel("x (mm)")
         bottom.set_ylabel("- wear depth (um)")
     fig.tight_layout()
-    paths.append(_savefig(fig, out / "profiles.png"))
+    paths.append(write_figure(out / "profiles.png", fig))
     # wear-scar maps
     fig, axes = plt.subplots(1, 2, figsize=(10, 4))
     for ax, body, x, w in ((axes[0], "lower", g.x_lower, hist.wear_lower),
@@ -74,7 +66,7 @@ def write_figures(hist: FrettingHistory, out: Path) -> list[Path]:
         ax.set_ylabel("y (mm)")
         ax.set_title(f"{body} body, cycle {hist.rows[-1]['cycle']}")
     fig.tight_layout()
-    paths.append(_savefig(fig, out / "wear_scar.png"))
+    paths.append(write_figure(out / "wear_scar.png", fig))
     # wear vs cycle
     c = np.array([r["cycle"] for r in hist.rows])
     jumped = np.array([r["jumped"] for r in hist.rows], dtype=bool)
@@ -93,7 +85,7 @@ def write_figures(hist: FrettingHistory, out: Path) -> list[Path]:
         ax.set_xlabel("cycle")
         ax.legend(title="dots: jumped" if jumped.any() else None)
     fig.tight_layout()
-    paths.append(_savefig(fig, out / "wear_vs_cycle.png"))
+    paths.append(write_figure(out / "wear_vs_cycle.png", fig))
     return paths
 
 

@@ -71,3 +71,13 @@ def write_npz(path: str | Path, **arrays: Any) -> Path:
         with p.open("wb") as fh:
             np.savez(fh, **arrays)
     return atomic_write(path, w)
+
+
+def write_figure(path: str | Path, fig: Any, dpi: int = 120) -> Path:
+    """Atomically save a matplotlib figure as PNG, then close it."""
+    import matplotlib.pyplot as plt
+
+    try:
+        return atomic_write(path, lambda p: fig.savefig(p, format="png", dpi=dpi))
+    finally:
+        plt.close(fig)

@@ -29,7 +29,7 @@ import numpy as np
 
 from tribodem.dem import Material, PlaneWall
 from tribodem.dem.contact import set_pair
-from tribodem.io.results import atomic_write
+from tribodem.io.results import write_figure
 from tribodem.materials.library import MaterialSpec
 from tribodem.materials.specimen import Specimen
 
@@ -185,10 +185,4 @@ def plot_stress_strain(res: CompressionResult, path: str | Path, title: str = ""
     ax.set_title(title or "uniaxial compression (seed 000 fig 6, eq 12)")
     fig.tight_layout()
 
-    def write(tmp: Path) -> None:
-        fig.savefig(tmp, dpi=120, format="png")
-
-    try:
-        return atomic_write(path, write)
-    finally:
-        plt.close(fig)
+    return write_figure(path, fig)

@@ -32,6 +32,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -190,6 +191,47 @@ def _wall_stress(sim: Simulation, w: float, h: float, t: float) -> float:
     return 0.5 * (lr + tb)
 
 
+def compact_by_radius_scaling(relax: Callable[[np.ndarray, np.ndarray, int],
+                                              tuple[np.ndarray, float]],
+                              pos: np.ndarray, radii: np.ndarray, f0: float, stress: float,
+                              modulus: float, max_iter: int, growth: float = 1.002
+                              ) -> tuple[np.ndarray, float, float, int]:
+    """Radius expansion from ``f0`` to full size in 10 stages, then a uniform radius scale
+    bracketed and bisected until the wall stress (``relax(pos, radii, steps) -> (pos, Pa)``)
+    is within a factor 2 of ``stress`` (PFC's isotropic-stress installation).
+
+    Returns (positions, radius scale, final stress Pa, iterations). If the band is not
+    reached, the tightest (over-stressed, jammed) state is kept.
+    """
+    for f in np.linspace(f0, 1.0, 10)[1:]:
+        pos, sig = relax(pos, radii * f, 300)
+    # bracket [lo (too loose), hi (too tight)], bisect
+    lo: float | None = None
+    hi: tuple[float, np.ndarray] | None = None
+    alpha, n_iter, start = 1.0, 0, pos
+    for _ in range(max_iter):
+        n_iter += 1
+        pos, sig = relax(start, radii * alpha, 600)
+        if 0.5 * stress <= sig <= 2.0 * stress:
+            break
+        if sig > 2.0 * stress:
+            hi = (alpha, pos)
+        else:
+            lo = alpha
+        if lo is not None and hi is not None:
+            alpha = 0.5 * (lo + hi[0])
+        elif hi is not None:
+            alpha = hi[0] * (1.0 - min(sig / modulus, 0.02))
+        else:
+            alpha = alpha * growth
+        start = pos if hi is None else hi[1]
+    else:
+        if hi is not None:
+            alpha, pos = hi[0], hi[1]
+            pos, sig = relax(pos, radii * alpha, 600)
+    return pos, alpha, sig, n_iter
+
+
 def _compact(spec: MaterialSpec, radii: np.ndarray, pos: np.ndarray, w: float, h: float,
              stress: float, max_iter: int) -> tuple[np.ndarray, np.ndarray, dict[str, float]]:
     """Isotropic compaction by radius expansion inside four fixed walls, then radius
@@ -214,34 +256,9 @@ def _compact(spec: MaterialSpec, radii: np.ndarray, pos: np.ndarray, w: float, h
         sim.step(steps)
         return sim.p.pos.copy(), _wall_stress(sim, w, h, t)
 
-    # radius expansion from the placement size to full size in 10 stages
-    f0 = math.sqrt(PHI0 / PHI_TARGET)
-    for f in np.linspace(f0, 1.0, 10)[1:]:
-        pos, sig = relax(pos, radii * f, 300)
-    # isotropic stress by radius scaling: bracket [lo (too loose), hi (too tight)], bisect
-    lo: float | None = None
-    hi: tuple[float, np.ndarray] | None = None
-    alpha, n_iter, start = 1.0, 0, pos
-    for _ in range(max_iter):
-        n_iter += 1
-        pos, sig = relax(start, radii * alpha, 600)
-        if 0.5 * stress <= sig <= 2.0 * stress:
-            break
-        if sig > 2.0 * stress:
-            hi = (alpha, pos)
-        else:
-            lo = alpha
-        if lo is not None and hi is not None:
-            alpha = 0.5 * (lo + hi[0])
-        elif hi is not None:
-            alpha = hi[0] * (1.0 - min(sig / spec.effective_modulus, 0.02))
-        else:
-            alpha = alpha * 1.002
-        start = pos if hi is None else hi[1]
-    else:
-        if hi is not None:  # not within the band: keep the jammed (over-stressed) state
-            alpha, pos = hi[0], hi[1]
-            pos, sig = relax(pos, radii * alpha, 600)
+    pos, alpha, sig, n_iter = compact_by_radius_scaling(
+        relax, pos, radii, math.sqrt(PHI0 / PHI_TARGET), stress, spec.effective_modulus,
+        max_iter)
     return pos, radii * alpha, {"compaction_iterations": float(n_iter),
                                 "compaction_stress_Pa": float(sig),
                                 "radius_scale": float(alpha)}
