@@ -51,6 +51,9 @@ tm.set_log_level(tm.LogLevel.error)
 
 REGIMES = ("gross", "ciavarella-jaeger")
 
+#: offsets whose normal solution is kept as the initial guess for the next visit
+_WARM_STARTS = 64
+
 
 class WindowTooSmallError(RuntimeError):
     """The contact reached the edge of the periodic window: enlarge ``window``."""
@@ -155,6 +158,9 @@ class HalfSpaceSolver(FirstBodySolver):
         self._factor = 1.0
         self._slip_acc = np.zeros((self.n, self.n))
         self._traction = np.zeros((self.n, self.n))
+        # normal solution (model traction) last found at each offset: the initial guess when
+        # that offset comes back (next cycle's geometry differs only by one cycle's wear)
+        self._warm: dict[float, NDArray[np.float64]] = {}
 
     def approach(self, pressure: NDArray[np.float64], gap: NDArray[np.float64]) -> float:
         """True (non-periodic) half-space rigid approach d of a solution, m.
@@ -231,7 +237,13 @@ class HalfSpaceSolver(FirstBodySolver):
                 self._slip_acc[:] = 0.0
             self._direction = new_dir
         g = self.gap(offset)
+        key = round(offset / self.dx, 9)
+        warm = self._warm.get(key)
+        if warm is not None:
+            self._model.traction[:] = warm
         p, gap = self._normal(g, self.load)
+        if key in self._warm or len(self._warm) < _WARM_STARTS:
+            self._warm[key] = np.array(self._model.traction, dtype=float)
         self._check_window(p, offset)
         contact = p > 0.0
         qx = np.zeros_like(p)
