@@ -43,22 +43,11 @@ _ROOT = Path(__file__).resolve().parents[1]
 
 
 def _load_cases():
-    """``tribodem.dem.bench_cases``; loaded from its file if the package import fails.
-
-    (The engine package may be mid-edit; bench_cases itself only needs numpy.)
-    """
+    """``tribodem.dem.bench_cases`` (the repository root is put on the path)."""
     if str(_ROOT) not in sys.path:
         sys.path.insert(0, str(_ROOT))
-    try:
-        from tribodem.dem import bench_cases
-    except ImportError:
-        import importlib.util
+    from tribodem.dem import bench_cases
 
-        spec = importlib.util.spec_from_file_location(
-            "_tribodem_bench_cases", _ROOT / "tribodem" / "dem" / "bench_cases.py")
-        bench_cases = importlib.util.module_from_spec(spec)
-        sys.modules[spec.name] = bench_cases  # dataclasses needs the module registered
-        spec.loader.exec_module(bench_cases)
     return bench_cases
 
 

@@ -11,6 +11,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from tribodem.dem.integrate import rayleigh_step
+
 
 @dataclass
 class BenchCase:
@@ -39,12 +41,6 @@ class BenchCase:
         return int(self.radii.size)
 
 
-def rayleigh_time_step(radius: float, density: float, young: float, poisson: float) -> float:
-    """Rayleigh critical step (seed 003 eq 2.17): pi R sqrt(rho/G) / (0.163 nu + 0.8766)."""
-    shear = young / (2.0 * (1.0 + poisson))
-    return math.pi * radius * math.sqrt(density / shear) / (0.163 * poisson + 0.8766)
-
-
 def settle3d_case(n: int = 20_000, steps: int = 2_000, seed: int = 0) -> BenchCase:
     """Case (a): n Hertz-Mindlin spheres settling under gravity in an open-top box.
 
@@ -63,7 +59,7 @@ def settle3d_case(n: int = 20_000, steps: int = 2_000, seed: int = 0) -> BenchCa
     pos[:, :2] += rng.uniform(-0.01, 0.01, size=(n, 2)) * s
     radii = rng.uniform(0.475e-3, 0.5e-3, size=n)
     young, nu, rho = 1.0e7, 0.3, 2500.0
-    dt = 0.2 * rayleigh_time_step(float(radii.min()), rho, young, nu)
+    dt = 0.2 * float(rayleigh_step(radii.min(), rho, young / (2.0 * (1.0 + nu)), nu))
     return BenchCase(
         name="settle3d", dim=3, positions=pos, radii=radii,
         box_lo=np.zeros(3), box_hi=np.array([nx * s, ny * s, (nz + 2) * s]),

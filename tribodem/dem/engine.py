@@ -9,7 +9,6 @@ The engine knows nothing about brakes or fretting; applications compose it.
 from __future__ import annotations
 
 import json
-from collections.abc import Callable
 from pathlib import Path
 from typing import Protocol
 
@@ -403,17 +402,3 @@ class Simulation:
             self.step_count = int(meta["step"])
             self.time = float(z["time_exact"][0])
             self.dt = float(meta["dt"])
-
-
-def settle_until(sim: Simulation, done: Callable[[Simulation], bool], max_steps: int,
-                 check: int = 100) -> int:
-    """Step in chunks of ``check`` until ``done(sim)`` or ``max_steps``; returns steps run."""
-    steps = 0
-    while steps < max_steps:
-        sim.step(check)
-        steps += check
-        if done(sim):
-            break
-    return steps
-
-

@@ -134,9 +134,13 @@ def advance(pos, vel, omega, radius, mass, inertia, mat, fixed, start, rev_start
         drift[blk] = dmax
 
 
-def rayleigh_step(radius: float, density: float, shear_modulus: float, poisson: float) -> float:
-    """Rayleigh time step (s), seed 003 eq 2.17: pi R sqrt(rho/G) / (0.163 nu + 0.8766)."""
-    return math.pi * radius * math.sqrt(density / shear_modulus) / (0.163 * poisson + 0.8766)
+def rayleigh_step(radius: float | np.ndarray, density: float | np.ndarray, shear_modulus: float,
+                  poisson: float) -> float | np.ndarray:
+    """Rayleigh time step (s), seed 003 eq 2.17: pi R sqrt(rho/G) / (0.163 nu + 0.8766).
+
+    Works element-wise on arrays of radii and densities.
+    """
+    return math.pi * radius * np.sqrt(density / shear_modulus) / (0.163 * poisson + 0.8766)
 
 
 def critical_step(density: np.ndarray, radius: np.ndarray, mass: np.ndarray,
@@ -158,8 +162,7 @@ def critical_step(density: np.ndarray, radius: np.ndarray, mass: np.ndarray,
     ray_p = np.full(rr.size, np.inf)
     for m_id, m in enumerate(materials):
         sel = mat == m_id
-        ray_p[sel] = (math.pi * rr[sel] * np.sqrt(density[sel] / m.shear_modulus)
-                      / (0.163 * m.poisson + 0.8766))
+        ray_p[sel] = rayleigh_step(rr[sel], density[sel], m.shear_modulus, m.poisson)
     if pair_i.size:
         i, j = pair_i, pair_j
         law = pairtab[mat[i], mat[j], P_LAW]
