@@ -6,21 +6,26 @@ wire them): ``state`` (particle arrays), ``space`` (box, periodic axes),
 servo walls), ``integrate`` (central difference with damping, time-step estimates),
 ``engine`` (``Simulation``: the step loop, checkpoints), ``recorders`` (CSV, VTK),
 ``bonds`` (linear parallel bonds, breakage log), ``thermal`` (temperature, expansion,
-conduction through intact bonds).
+conduction through intact bonds), ``clumps`` (rigid multi-sphere debris bodies),
+``trimesh`` (rigid triangle-mesh surfaces, e.g. from STL).
 """
 
 from tribodem.dem.bonds import BondBreak, ParallelBonds, install_bonds_by_gap
+from tribodem.dem.clumps import Clumps, ClumpTemplate, debris_template, make_clumps
 from tribodem.dem.contact import Material
 from tribodem.dem.engine import Simulation
 from tribodem.dem.errors import SimulationUnstable, TimeStepError
 from tribodem.dem.space import Box
 from tribodem.dem.state import ParticleState
 from tribodem.dem.thermal import Thermal
+from tribodem.dem.trimesh import TriangleSurface
 from tribodem.dem.walls import PlaneWall
 
 __all__ = [
     "BondBreak",
     "Box",
+    "ClumpTemplate",
+    "Clumps",
     "Material",
     "ParallelBonds",
     "ParticleState",
@@ -29,5 +34,8 @@ __all__ = [
     "SimulationUnstable",
     "Thermal",
     "TimeStepError",
+    "TriangleSurface",
+    "debris_template",
     "install_bonds_by_gap",
+    "make_clumps",
 ]

@@ -31,6 +31,9 @@ class Interaction(Protocol):
 
     ``compute(sim)`` runs every step after the pair contacts and adds its forces and
     moments into ``sim.ext_force`` / ``sim.ext_torque`` (zeroed before, N and N m).
+    Optional hooks: ``after_advance(sim)`` runs right after the particle update (rigid
+    clumps integrate their bodies there); ``filter_pairs(nl)`` returns the neighbour list
+    without pairs that must not interact (members of one clump), after every build.
     """
 
     def compute(self, sim: Simulation) -> None: ...
@@ -72,6 +75,8 @@ class Simulation:
         self.track_energy = bool(track_energy)
         self._at_force_eval: tuple[np.ndarray, ...] | None = None
         self.interactions: list[Interaction] = []
+        self._after: list = []  # interactions with an after_advance hook
+        self._pair_filters: list = []  # interactions with a filter_pairs hook
         self.recorders: list[tuple[int, Recorder]] = []
         self.step_count = 0
         self.time = 0.0
@@ -165,6 +170,18 @@ class Simulation:
                         f"limited by {self.dt_limit_by}; use dt <= {dt_c:.6g} s "
                         "(or force_dt=True)")
         self.interactions.append(inter)
+        if hasattr(inter, "after_advance"):
+            self._after.append(inter)
+        if hasattr(inter, "filter_pairs"):
+            self._pair_filters.append(inter)
+            old, old_hist = self.nl, self.hist
+            self.nl = inter.filter_pairs(old)
+            if self.nl is not old:
+                self.hist = np.zeros((self.nl.n_pairs, HIST))
+                neighbors.transfer_history.pick(self.p.n)(old.start, old.pair_j, old_hist,
+                                                          self.nl.start, self.nl.pair_j,
+                                                          self.hist)
+                self._alloc_pairs()
 
     def add_recorder(self, recorder: Recorder, every: int) -> None:
         """Sample ``recorder`` every ``every`` steps (and once at the start)."""
@@ -179,6 +196,8 @@ class Simulation:
         old, old_hist = self.nl, self.hist
         self.nl = neighbors.build(self.p.pos, self.p.radius, self.skin, self.box.lo,
                                   self.box.hi, self.box.periodic, old.builds)
+        for inter in self._pair_filters:
+            self.nl = inter.filter_pairs(self.nl)
         self.hist = np.zeros((self.nl.n_pairs, HIST))
         neighbors.transfer_history.pick(self.p.n)(old.start, old.pair_j, old_hist,
                                                   self.nl.start, self.nl.pair_j, self.hist)
@@ -217,7 +236,8 @@ class Simulation:
 
         A step: neighbour list if needed -> pair contacts -> extra interactions (into
         ``ext_force``/``ext_torque``) -> per particle: gather, walls, update, wrap ->
-        walls move (servo uses the wall force just measured).
+        ``after_advance`` hooks (clump bodies) -> walls move (servo uses the wall force
+        just measured).
         """
         try:
             if self.step_count == 0 and self.time == 0.0:
@@ -234,6 +254,8 @@ class Simulation:
                     p = self.p
                     self._at_force_eval = (p.pos.copy(), p.vel.copy(), p.omega.copy())
                 self._advance()
+                for inter in self._after:
+                    inter.after_advance(self)
                 for w in self.walls:
                     w.update_motion(self.dt)
                 self.step_count += 1

@@ -15,6 +15,8 @@ FIX_X, FIX_Y, FIX_Z, FIX_RX, FIX_RY, FIX_RZ = 1, 2, 4, 8, 16, 32
 FIX_TRANSLATION = FIX_X | FIX_Y | FIX_Z
 FIX_ROTATION = FIX_RX | FIX_RY | FIX_RZ
 FIX_2D = FIX_Z | FIX_RX | FIX_RY
+# marks a member sphere of a rigid clump (``dem.clumps``): its body integrates it
+FIX_CLUMP = 64
 
 
 @dataclass
