@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from tribodem.braking.compare import change_with_error, step_verdict, trend_verdict
 from tribodem.braking.conditions import (
     CONDITIONS,
     FRICTION_RADIUS_M,
@@ -21,7 +22,14 @@ from tribodem.braking.conditions import (
     speed_to_rpm,
 )
 from tribodem.braking.measure import classify, measure, reference
-from tribodem.braking.model import DISC, PAD, Geometry, build_interface, start_sliding
+from tribodem.braking.model import (
+    DISC,
+    PAD,
+    Geometry,
+    build_interface,
+    plate_force,
+    start_sliding,
+)
 from tribodem.braking.run import RunSetup, run_braking, wear_extrapolation
 from tribodem.dem.state import FIX_X, FIX_Y
 
@@ -61,7 +69,12 @@ def test_interface_geometry_and_boundary_conditions() -> None:
     # rough: the outer surfaces vary by more than one particle diameter along x
     assert np.ptp(p.pos[disc, 1][np.argsort(p.pos[disc, 1])[-10:]]) > 0
     assert np.all(p.fixed[it.anchor_disc] & (FIX_X | FIX_Y) == (FIX_X | FIX_Y))
-    assert np.all(p.fixed[it.anchor_pad] & FIX_X) and not np.any(p.fixed[it.anchor_pad] & FIX_Y)
+    # absorbing backing (default): the pad's top layer is free, held by dashpots
+    assert not np.any(p.fixed[it.anchor_pad] & (FIX_X | FIX_Y)) and it.backing is not None
+    assert it.backing.c_n > it.backing.c_t > 0
+    held = build_interface(SMALL, 0.33e6, backing="support")
+    assert np.all(held.sim.p.fixed[held.anchor_pad] & FIX_X) and held.backing is None
+    assert not np.any(held.sim.p.fixed[held.anchor_pad] & FIX_Y)
     assert it.anchor_disc.sum() >= 5 and it.anchor_pad.sum() >= 5
     # bonds only inside each body; the target force is p W t
     b = it.bonds
@@ -78,6 +91,58 @@ def test_interface_geometry_and_boundary_conditions() -> None:
     assert m["force_chains"] >= 0.9 * b.n_bonds  # every loaded intact bond is a chain
     with pytest.raises(ValueError, match="width"):
         build_interface(Geometry(width=1e-6), 0.33e6)
+
+
+def _pad_vibration(backing: str, steps: int) -> float:
+    """Internal kinetic energy (J) of the pad ``steps`` after kicking its lowest layer up
+    at 1 m/s (pad clear of the disc)."""
+    geo = Geometry(width=100e-6, disc_height=36e-6, pad_height=36e-6, amplitude=4e-6,
+                   modes=2, seed=3, clearance=2e-6)
+    it = build_interface(geo, 0.33e6, backing=backing)
+    p = it.sim.p
+    pad = p.group == PAD
+    low = pad & (p.pos[:, 1] - p.radius < (p.pos[pad, 1] - p.radius[pad]).min()
+                 + 2 * p.radius.mean())
+    p.vel[low, 1] = 1.0
+    it.sim.step(steps)
+    v, m = p.vel[pad], p.mass[pad]
+    vm = (m[:, None] * v).sum(0) / m.sum()
+    return 0.5 * float((m[:, None] * (v - vm) ** 2).sum())
+
+
+def test_absorbing_backing_lets_waves_leave_the_pad() -> None:
+    """The Lysmer backing (rest of the pad) absorbs the waves a free back face reflects:
+    measured 1.1e-9 J vs 1.1e-8 J after 1000 steps (~15 pad transits)."""
+    ab, held = _pad_vibration("absorbing", 1000), _pad_vibration("support", 1000)
+    assert ab < 0.25 * held
+
+
+def test_plate_force_includes_backing_reaction() -> None:
+    it = build_interface(SMALL, 0.33e6)
+    start_sliding(it, 30.0)
+    it.sim.step(50)
+    assert plate_force(it) == pytest.approx(it.wall.normal_force + it.backing.reaction)
+    # the plate is driven by the target minus the dashpots' reaction (momentum balance)
+    assert it.wall.target_force == pytest.approx(it.target_force - it.backing.reaction)
+
+
+def test_change_errors_and_verdicts() -> None:
+    a, b = np.array([1.0, 1.1, 0.9]), np.array([1.5, 1.6, 1.4])
+    pct, se = change_with_error(a, b, paired=False)
+    assert pct == pytest.approx(50.0) and se == pytest.approx(10.408, rel=1e-3)
+    assert change_with_error(a, b) == (pytest.approx(50.0), pytest.approx(0.0, abs=1e-9))
+    pct, se = change_with_error(a, np.array([1.5, 1.5, 1.5]))  # paired: sd(b - a) = 0.1
+    assert se == pytest.approx(100 * 0.1 / np.sqrt(3), rel=1e-6)
+    assert step_verdict(pct, se) == "up"
+    assert step_verdict(5.0, 4.0) == "not resolved" and step_verdict(-9.0, 4.0) == "down"
+    assert np.isnan(change_with_error(np.array([1.0]), np.array([2.0]))[1])
+    assert trend_verdict([(10, 2), (10, 2)], (20, 3), "up").startswith("reproduced")
+    assert trend_verdict([(10, 2), (-10, 2)], (1, 3), "up").startswith("not resolved")
+    assert trend_verdict([(-10, 2), (-10, 2)], (-20, 3), "up").startswith("not reproduced")
+    assert trend_verdict([(-10, 2), (-10, 2)], (-20, 3), "down").startswith("reproduced")
+    # with 3 seeds a change must exceed t(0.975, 2) = 4.30 standard errors
+    assert step_verdict(10.0, 4.0) == "up" and step_verdict(10.0, 4.0, 3) == "not resolved"
+    assert step_verdict(10.0, 2.0, 3) == "up"
 
 
 @pytest.fixture(scope="module")

@@ -315,3 +315,29 @@ def test_reset_and_reuse_gives_same_result():
     r2 = replay(s, c, inc)
     assert r1.cycles_simulated == r2.cycles_simulated
     assert math.isclose(r1.final_value, r2.final_value)
+
+
+def test_adaptive_total_decides_on_the_sum_of_an_array_state() -> None:
+    """A map whose points start wearing one after another (kinks) while the total grows
+    linearly: deciding on every point never jumps, deciding on the total does."""
+    from tribodem.cyclejump import AdaptiveJump
+
+    def state(c: int) -> np.ndarray:
+        # point k wears at rate 1 from cycle 3 k on; a last point absorbs the rest so the
+        # total is exactly 10 c
+        w = np.clip(c - 3.0 * np.arange(8), 0.0, None)
+        return np.append(w, 10.0 * c - w.sum())
+
+    jumps = {}
+    for mode in ("worst", "total"):
+        s = AdaptiveJump(decide_on=mode)
+        s.observe(0, state(0))
+        total = 0
+        for c in range(1, 40):
+            s.observe(c, state(c))
+            total += s.propose_jump()
+        jumps[mode] = total
+    assert jumps["worst"] == 0
+    assert jumps["total"] > 0
+    with pytest.raises(ValueError, match="decide_on"):
+        AdaptiveJump(decide_on="mean")

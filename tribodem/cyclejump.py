@@ -381,8 +381,12 @@ class AdaptiveJump(JumpStrategy):
     d. moving window: at that point the old polynomial is abandoned and the window restarts
        at the present cycle (``moving_window=True``).
 
-    For an array state every element is fitted; the worst element carrying wear decides
-    convergence and linearity, and each element is extrapolated by its own f'.
+    For an array state every element is fitted and extrapolated by its own f'. With
+    ``decide_on="worst"`` the worst element carrying wear decides convergence and linearity;
+    with ``"total"`` the sum of the elements does (for a wear-depth map: the worn volume).
+    Decision: the fretting loop uses ``"total"``: on a grid, a point the growing scar reaches
+    starts wearing with a kink, so single points never look polynomial, while the worn
+    volume does (the fit is linear in the data: the sum's fit is the sum of the fits).
     """
 
     name = "adaptive"
@@ -406,7 +410,12 @@ class AdaptiveJump(JumpStrategy):
         window_fraction: float | None = 0.5,
         curvature_over_window: bool = True,
         taylor_order: int = 1,
+        decide_on: str = "worst",
     ) -> None:
+        if decide_on not in ("worst", "total"):
+            raise ValueError(f"decide_on = {decide_on!r}: must be 'worst' (every element) or "
+                             "'total' (the sum of the state, e.g. the worn volume)")
+        self.decide_on = decide_on
         if degree < 1:
             raise ValueError("degree must be >= 1")
         if taylor_order not in (1, 2):
@@ -512,6 +521,18 @@ class AdaptiveJump(JumpStrategy):
         denom = np.where(denom > 0, denom, np.inf)
         return float(np.max(np.abs(c - prev) / denom))
 
+    def _converged_total(self, t0: float, t1: float, act: NDArray[np.bool_]) -> float:
+        """Relative coefficient change (eqs 4.9-4.12) of the fit of the summed state."""
+        assert self._coef is not None and self._prev is not None
+        c = self._coef[:, act].sum(axis=1)
+        prev = self._prev[:, act].sum(axis=1)
+        p = np.arange(c.size - 1, -1, -1, dtype=float)
+        rise = abs(float(np.polyval(c, t1) - np.polyval(c, t0)))
+        floor = self.coef_floor * rise / max(t1 - t0, 1.0) ** p
+        denom = np.maximum(np.abs(prev), floor)
+        denom = np.where(denom > 0, denom, np.inf)
+        return float(np.max(np.abs(c - prev) / denom))
+
     def _restart_window(self) -> None:
         self._n0 = len(self._cycles) - 1
         self._coef = None
@@ -539,9 +560,14 @@ class AdaptiveJump(JumpStrategy):
             act = _active(d1)
             if np.any(act):
                 rise = np.polyval(self._coef, t_end) - np.polyval(self._coef, float(t[0]))
-                qc = self._converged(t_end - float(t[0]), rise, act)
+                d1s, d2s = self._derivs(float(t[0]))
+                if self.decide_on == "total":
+                    qc = self._converged_total(float(t[0]), t_end, act)
+                    d1, d2, d2s = (np.array([np.sum(v[act])]) for v in (d1, d2, d2s))
+                    act = np.ones(1, dtype=bool)
+                else:
+                    qc = self._converged(t_end - float(t[0]), rise, act)
                 if self.curvature_over_window:
-                    d1s, d2s = self._derivs(float(t[0]))
                     d2 = np.maximum(np.abs(d2), np.abs(d2s))
                 curv = float(np.max(np.abs(d2[act]) / np.abs(d1[act])))
                 if qc <= self.q_coef and curv <= self.q_y_at(cycle):

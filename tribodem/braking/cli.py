@@ -44,7 +44,7 @@ class GeometryCfg(_Strict):
 
     width_m: float = Field(216e-6, gt=0)
     disc_height_m: float = Field(72e-6, gt=0)
-    pad_height_m: float = Field(72e-6, gt=0)
+    pad_height_m: float = Field(108e-6, gt=0)
     roughness_amplitude_m: float = Field(8e-6, ge=0)
     roughness_modes: int = Field(4, ge=1, le=64)
     clearance_m: float = Field(5e-8, ge=0)
@@ -58,7 +58,12 @@ class RunCfg(_Strict):
     samples: int = Field(150, ge=2, le=100_000)
     vtk_snapshots: int = Field(6, ge=0, le=10_000)
     micro: Literal["calibrated", "table3"] = "calibrated"
-    wall_mass_ratio: float = Field(0.05, gt=0, le=10)
+    plate_areal_mass_kg_m2: float = Field(
+        0.0, ge=0, le=1e4,
+        description="pressure plate mass per area (kg/m^2), e.g. 126 for the omitted pad "
+                    "and back plate; 0 = wall_mass_ratio x the cell's pad mass")
+    wall_mass_ratio: float = Field(0.05, gt=0, le=1000)
+    backing: Literal["absorbing", "support"] = "absorbing"
     local_damping: float = Field(0.0, ge=0, lt=1)
     dt_safety: float = Field(0.3, gt=0, le=1)
     threads: int = Field(0, ge=0, le=256, description="0 = all cores")
@@ -136,6 +141,7 @@ def setup_from_config(cfg: BrakingConfig) -> Any:
     return RunSetup(pressure_Pa=p, speed_m_s=v, duration_s=r.duration_s, geometry=geo,
                     condition=None if explicit else c.index, micro=r.micro, samples=r.samples,
                     vtk_snapshots=r.vtk_snapshots, wall_mass_ratio=r.wall_mass_ratio,
+                    plate_areal_mass=r.plate_areal_mass_kg_m2 or None, backing=r.backing,
                     local_damping=r.local_damping, dt_safety=r.dt_safety,
                     thermal_curve=curve, thermal_time_map=cfg.thermal.time_map,
                     figures=r.figures)

@@ -44,6 +44,67 @@ def _fmt(x: float | None) -> str:
     return "-" if x is None or not np.isfinite(x) else f"{x:+.2f}%"
 
 
+def change_with_error(a: np.ndarray, b: np.ndarray, paired: bool = True
+                      ) -> tuple[float, float]:
+    """Relative change (%) of the mean of ``b`` over the mean of ``a`` and its standard
+    error (%; nan with one seed). ``paired`` (same length): entry s of both comes from the
+    same packing and roughness seed (a sweep's conditions share them), so the error is
+    that of the mean per-seed difference, ``sd(b - a) / sqrt(n) / mean(a)``; otherwise
+    the standard errors of both means are propagated to first order."""
+    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+    ma, mb = float(a.mean()), float(b.mean())
+    pct = _pct(ma, mb)
+    if min(a.size, b.size) < 2 or ma == 0 or mb == 0:
+        return pct, float("nan")
+    if paired and a.size == b.size:
+        return pct, 100.0 * float((b - a).std(ddof=1)) / np.sqrt(a.size) / abs(ma)
+    sa = float(a.std(ddof=1)) / np.sqrt(a.size)
+    sb = float(b.std(ddof=1)) / np.sqrt(b.size)
+    return pct, 100.0 * abs(mb / ma) * float(np.hypot(sa / ma, sb / mb))
+
+
+def _factor(n: int | None) -> float:
+    """Multiple of the standard error a change must exceed: the two-sided 95% Student t
+    quantile with n - 1 degrees of freedom (n seeds), or 2 when n is not given."""
+    if n is None:
+        return 2.0
+    from scipy.stats import t as student_t
+
+    return float(student_t.ppf(0.975, max(n - 1, 1)))
+
+
+def step_verdict(pct: float, se: float, n: int | None = None) -> str:
+    """``up`` / ``down`` when the change exceeds ``_factor(n)`` standard errors (95% t
+    for n seeds), else ``not resolved`` (``no scatter`` with one seed)."""
+    if not np.isfinite(se):
+        return "no scatter (1 seed)"
+    k = _factor(n)
+    if pct > k * se:
+        return "up"
+    if pct < -k * se:
+        return "down"
+    return "not resolved"
+
+
+def trend_verdict(steps: list[tuple[float, float]], total: tuple[float, float],
+                  want: str, n: int | None = None) -> str:
+    """Verdict on a seed trend (``want`` = ``up`` or ``down``) from its two steps and the
+    total change, each (pct, se), over n seeds."""
+    tv = step_verdict(*total, n)
+    sv = [step_verdict(*x, n) for x in steps]
+    other = "down" if want == "up" else "up"
+    if tv == want and other not in sv:
+        return "reproduced (total change resolved, no step resolved against it)"
+    if tv == want:
+        return "partly: total change resolved, but a step is resolved against it"
+    if tv == other:
+        return "not reproduced: the total change is resolved in the opposite direction"
+    sign_ok = (total[0] > 0) == (want == "up")
+    return ("not resolved: the sign of the total change agrees, but it is within the 95% "
+            "interval" if sign_ok else
+            "not reproduced: the total change has the opposite sign (within the scatter)")
+
+
 def _mean_summary(runs: list[dict[str, Any]]) -> dict[str, Any]:
     """Mean over seeds of every numeric summary entry (the first run's other entries)."""
     out = dict(runs[0])
@@ -53,40 +114,79 @@ def _mean_summary(runs: list[dict[str, Any]]) -> dict[str, Any]:
     return out
 
 
+def _pm(pct: float, se: float) -> str:
+    return _fmt(pct) if not np.isfinite(se) else f"{pct:+.1f} +- {se:.1f}%"
+
+
 def write_comparison(out: Path, runs: dict[int, list[tuple[dict[str, Any], Path]]],
                      wall_s: float, workers: int, quick: bool) -> list[tuple[str, str, str]]:
     """Write comparison.csv and comparison.md from the runs of each condition (one per
-    packing seed; values are seed means); return (label, ours, seed) wear rows."""
+    packing seed): seed means, the standard error of each change over seeds, and a
+    verdict per change and per trend; return (label, ours, seed) wear rows."""
     results = {k: _mean_summary([r for r, _ in v]) for k, v in runs.items()}
     n_seeds = min(len(v) for v in runs.values())
     series = {k: _series(v[0][1]) for k, v in runs.items()}  # condition 5 history: seed 0
-    wear = {k: results[k]["wear_depth_mean_m"] for k in results}
-    spread = {k: float(np.std([r["wear_depth_mean_m"] for r, _ in v])) for k, v in runs.items()}
-    chains = {k: float(np.mean([_late_mean(_series(d), "force_chains") for _, d in v]))
-              for k, v in runs.items()}
-    strong = {k: float(np.mean([_late_mean(_series(d), "strong_force_chains")
-                                for _, d in v])) for k, v in runs.items()}
+    per_seed = {
+        "wear": {k: np.array([r["wear_depth_mean_m"] for r, _ in v]) for k, v in runs.items()},
+        "rate": {k: np.array([r["steady_wear_rate_m_s"] for r, _ in v])
+                 for k, v in runs.items()},
+        "chains": {k: np.array([_late_mean(_series(d), "force_chains") for _, d in v])
+                   for k, v in runs.items()},
+        "strong": {k: np.array([_late_mean(_series(d), "strong_force_chains") for _, d in v])
+                   for k, v in runs.items()},
+    }
+    wear = {k: float(x.mean()) for k, x in per_seed["wear"].items()}
+    spread = {k: float(x.std(ddof=1)) if x.size > 1 else float("nan")
+              for k, x in per_seed["wear"].items()}
+    rate = {k: float(x.mean()) for k, x in per_seed["rate"].items()}
+    rate_sd = {k: float(x.std(ddof=1)) if x.size > 1 else float("nan")
+               for k, x in per_seed["rate"].items()}
+    chains = {k: float(x.mean()) for k, x in per_seed["chains"].items()}
+    strong = {k: float(x.mean()) for k, x in per_seed["strong"].items()}
+    ch: dict[str, dict[tuple[int, int], tuple[float, float]]] = {
+        q: {(a, b): change_with_error(per_seed[q][a], per_seed[q][b])
+            for _, a, b, _, _ in SEED_CHANGES} for q in per_seed}
     rows_csv = []
     lines = []
     printed = []
     for label, a, b, seed_w, seed_c in SEED_CHANGES:
-        ow, oc, os_ = _pct(wear[a], wear[b]), _pct(chains[a], chains[b]), _pct(strong[a],
-                                                                              strong[b])
-        rows_csv.append([label, a, b, wear[a], wear[b], ow, seed_w, chains[a], chains[b], oc,
+        (ow, ow_se), (orr, orr_se) = ch["wear"][(a, b)], ch["rate"][(a, b)]
+        (oc, oc_se), (os_, _) = ch["chains"][(a, b)], ch["strong"][(a, b)]
+        rows_csv.append([label, a, b, n_seeds, wear[a], wear[b], ow, ow_se,
+                         step_verdict(ow, ow_se, n_seeds), seed_w, rate[a], rate[b], orr, orr_se,
+                         step_verdict(orr, orr_se, n_seeds), chains[a], chains[b], oc, oc_se,
                          "" if seed_c is None else seed_c, os_])
-        lines.append(f"| {label} | {a}->{b} | {wear[a] * 1e6:.3f} -> {wear[b] * 1e6:.3f} | "
-                     f"{_fmt(ow)} | {_fmt(seed_w)} | {chains[a]:.1f} -> {chains[b]:.1f} | "
-                     f"{_fmt(oc)} | {_fmt(seed_c)} | {_fmt(os_)} |")
-        printed.append((label, _fmt(ow), _fmt(seed_w)))
+        lines.append(f"| {label} | {a}->{b} | {wear[a] * 1e6:.2f} -> {wear[b] * 1e6:.2f} | "
+                     f"{_pm(ow, ow_se)} | {step_verdict(ow, ow_se, n_seeds)} | {_fmt(seed_w)} | "
+                     f"{_pm(orr, orr_se)} | {step_verdict(orr, orr_se, n_seeds)} | "
+                     f"{chains[a]:.0f} -> {chains[b]:.0f} | {_pm(oc, oc_se)} | "
+                     f"{_fmt(seed_c)} |")
+        printed.append((label, _pm(ow, ow_se), _fmt(seed_w)))
     write_csv(out / "comparison.csv",
-              ["change", "from_condition", "to_condition", "wear_depth_from_m",
-               "wear_depth_to_m", "wear_depth_change_pct", "seed_wear_depth_change_pct",
-               "force_chains_from", "force_chains_to", "force_chains_change_pct",
+              ["change", "from_condition", "to_condition", "seeds", "wear_depth_from_m",
+               "wear_depth_to_m", "wear_depth_change_pct", "wear_depth_change_se_pct",
+               "wear_depth_verdict", "seed_wear_depth_change_pct", "wear_rate_from_m_s",
+               "wear_rate_to_m_s", "wear_rate_change_pct", "wear_rate_change_se_pct",
+               "wear_rate_verdict", "force_chains_from", "force_chains_to",
+               "force_chains_change_pct", "force_chains_change_se_pct",
                "seed_force_chains_change_pct", "strong_force_chains_change_pct"], rows_csv)
-    load_up = wear[1] < wear[2] < wear[5]
-    speed_up = wear[3] < wear[4] < wear[5]
-    load_chain = chains[1] > chains[2] > chains[5]
-    speed_chain = chains[3] > chains[4] > chains[5]
+
+    def trend(q: str, ks: tuple[int, int, int], want: str) -> str:
+        a, b, c = ks
+        return trend_verdict([ch[q][(a, b)], ch[q][(b, c)]], ch[q][(a, c)], want, n_seeds)
+
+    verdicts = [
+        ("wear depth rises with load (13 -> 17 -> 21 kN; seed +24.75%)",
+         trend("wear", (1, 2, 5), "up")),
+        ("wear depth rises with speed (800 -> 1000 -> 1200 r/min; seed +16.22%)",
+         trend("wear", (3, 4, 5), "up")),
+        ("steady wear rate (2nd half) rises with load", trend("rate", (1, 2, 5), "up")),
+        ("steady wear rate (2nd half) rises with speed", trend("rate", (3, 4, 5), "up")),
+        ("force chains fall with load (seed -23.37%, -5.96%)",
+         trend("chains", (1, 2, 5), "down")),
+        ("force chains fall with speed (seed -15.58%, -3.86%)",
+         trend("chains", (3, 4, 5), "down")),
+    ]
     r5 = results[5]
     s5 = series[5]
     t_sim = float(r5["simulated_time_s"])
@@ -96,7 +196,7 @@ def write_comparison(out: Path, runs: dict[int, list[tuple[dict[str, Any], Path]
         h = float(np.interp(tt, s5["time_s"], s5["wear_depth_mean_m"]))
         hist.append(f"| {ts:g} | {hs * 1e3:.3g} | {tt * 1e6:.3g} | {h * 1e3:.3g} | "
                     f"{hs / SEED_FIG12[-1][1]:.3f} | "
-                    f"{h / max(r5['wear_depth_mean_m'], 1e-300):.3f} |")
+                    f"{h / max(float(s5['wear_depth_mean_m'][-1]), 1e-300):.3f} |")
     per = []
     for k in sorted(results):
         r = results[k]
@@ -104,62 +204,62 @@ def write_comparison(out: Path, runs: dict[int, list[tuple[dict[str, Any], Path]
         per.append(f"| {k} | {c.load_kN:g} | {r['pressure_Pa'] / 1e6:.4g} | {c.rpm:g} | "
                    f"{r['sliding_speed_m_s']:.4g} | {r['simulated_time_s'] * 1e6:.3g} | "
                    f"{r['simulated_sliding_distance_m'] * 1e6:.4g} | "
-                   f"{r['wear_depth_mean_m'] * 1e6:.3f} +- {spread[k] * 1e6:.3f} | "
-                   f"{r['wear_depth_max_m'] * 1e6:.3f} | "
-                   f"{r['wear_depth_mean_disc_m'] * 1e6:.3f} | {int(r['broken_bonds'])} "
-                   f"({int(r['broken_bonds_tensile'])}/{int(r['broken_bonds_shear'])}) | "
-                   f"{int(r['debris_particles'])} | {chains[k]:.1f} | {strong[k]:.1f} | "
+                   f"{wear[k] * 1e6:.2f} +- {spread[k] * 1e6:.2f} | "
+                   f"{rate[k]:.3g} +- {rate_sd[k]:.2g} | "
+                   f"{r['wear_depth_max_m'] * 1e6:.1f} | "
+                   f"{r['wear_depth_mean_disc_m'] * 1e6:.2f} | {r['broken_bonds']:.0f} "
+                   f"({r['broken_bonds_tensile']:.0f}/{r['broken_bonds_shear']:.0f}) | "
+                   f"{r['debris_particles']:.0f} | {chains[k]:.0f} | {strong[k]:.0f} | "
                    f"{r['mean_wall_pressure_ratio']:.3f} | "
-                   f"{int(r['particles_final'])}/{int(r['particles_initial'])} | "
+                   f"{r['particles_final']:.0f}/{r['particles_initial']:.0f} | "
                    f"{r['wall_time_s']:.0f} |")
-
-    rel = [spread[k] / wear[k] for k in wear if wear[k] > 0]
+    seeds_txt = "; ".join(
+        f"{k}: " + ", ".join(f"{x * 1e6:.1f}" for x in per_seed["wear"][k])
+        for k in sorted(per_seed["wear"]))
+    rel = [spread[k] / wear[k] for k in wear if wear[k] > 0 and np.isfinite(spread[k])]
     scatter = (f"Seed-to-seed scatter of the pad wear depth: sd/mean = "
-               f"{100 * min(rel):.1f}-{100 * max(rel):.1f}% over {n_seeds} seeds; a change "
-               "smaller than about twice that is not resolved by this sweep."
-               if n_seeds > 1 and rel else
+               f"{100 * min(rel):.1f}-{100 * max(rel):.1f}% over {n_seeds} seeds. A change "
+               f"is called up/down only when it exceeds {_factor(n_seeds):.2f} standard "
+               f"errors (two-sided 95% Student t, {n_seeds - 1} degrees of freedom), "
+               "otherwise 'not resolved'. The conditions of one seed share its packing "
+               "and roughness (only load and speed differ), so changes are paired: the "
+               "error is that of the mean per-seed difference." if rel else
                "One packing per condition: the scatter between packings is not measured "
-               "here (use --seeds N); changes of ~10% are within the scatter seen with 3 "
-               "seeds (docs/braking.md).")
-
-    def verdict(ok: bool, what: str) -> str:
-        return (f"- {what}: **reproduced** in this sweep." if ok else
-                f"- {what}: **not reproduced** in this sweep (see the values above; not tuned).")
-
+               "here (use --seeds N), so no change can be called resolved.")
     text = "\n".join([
         "# Braking sweep: tribodem vs seed 000" + (" (--quick)" if quick else ""),
         "",
         f"5 conditions (table 4) x {n_seeds} packing/roughness seed(s) in {wall_s:.0f} s on "
-        f"{workers} worker processes; values are seed means (+- the standard deviation "
-        "over seeds for the wear depth). Every run "
-        f"simulates {t_sim * 1e6:.3g} us of sliding (the same braking time for all "
-        "conditions, as the seed compares at 8 s); the seed's 8 s are not simulated "
-        f"(fraction {t_sim / SEED_BRAKING_TIME_S:.2e}). Wear depth = mean pad wear depth at "
-        "the end (worn solid area / (packing fraction x width)); force chains = time mean "
-        "over the second half of the run (counts fluctuate contact by contact).",
+        f"{workers} worker processes; values are seed means +- the standard deviation over "
+        f"seeds. Every run simulates {t_sim * 1e6:.3g} us of sliding (the same braking time "
+        "for all conditions, as the seed compares at 8 s); the seed's 8 s are not "
+        f"simulated (fraction {t_sim / SEED_BRAKING_TIME_S:.2e}). Wear depth = mean pad "
+        "wear depth at the end (worn solid area / (packing fraction x width)); wear rate = "
+        "least-squares slope of the pad wear depth over the second half of the run (after "
+        "the run-in); force chains = time mean over the second half of the run.",
         "",
         "## Per condition",
         "",
         "| cond. | load kN | p MPa | r/min | v m/s | t_sim us | slid um | pad wear mean um "
-        "(+- sd) | "
-        "pad wear max um | disc wear mean um | broken bonds (tens./shear) | debris | "
-        "chains | strong chains | mean wall p / target | particles end/start | wall s |",
-        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
+        "(+- sd) | wear rate 2nd half m/s (+- sd) | pad wear max um | disc wear mean um | "
+        "broken bonds (tens./shear) | debris | chains | strong chains | mean plate force / "
+        "target | particles end/start | wall s |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
         *per,
         "",
-        "## Changes: ours beside the seed's (section 5)",
+        f"Pad wear depth per seed (um), condition: values -- {seeds_txt}.",
         "",
-        "| change | conditions | our wear depth um | our wear change | seed wear change | "
-        "our force chains | our chain change | seed chain change | our strong-chain change |",
-        "|---|---|---|---|---|---|---|---|---|",
+        "## Changes: ours (mean change +- standard error) beside the seed's (section 5)",
+        "",
+        "| change | conditions | our wear depth um | our wear change | verdict | "
+        "seed wear change | our wear-rate change | verdict | our force chains | "
+        "our chain change | seed chain change |",
+        "|---|---|---|---|---|---|---|---|---|---|---|",
         *lines,
         "",
         "## Trends",
         "",
-        verdict(load_up, "wear depth rises with load (13 -> 17 -> 21 kN)"),
-        verdict(speed_up, "wear depth rises with speed (800 -> 1000 -> 1200 r/min)"),
-        verdict(load_chain, "force chains fall with load"),
-        verdict(speed_chain, "force chains fall with speed"),
+        *[f"- {w}: **{v}**." for w, v in verdicts],
         "",
         scatter,
         "",

@@ -16,13 +16,19 @@ Boundary conditions (figure 8):
   fixed in y (the disc's "pressure wall") and, while sliding, driven in -x at the sliding
   speed (PFC applies the disc's linear speed to its particles; the rest of the disc starts
   at the same velocity and follows through bonds and contacts);
-- pad: the particles within one mean diameter of its top are held in x (the support wall,
-  FIX_X, vx = 0) and pressed in -y by a pressure wall with the target force ``p W t``
+- pad: the particles within one mean diameter of its top are held in x (the support wall)
+  and pressed in -y by a pressure wall with the target force ``p W t``
   (pressure x cell width x disk thickness, 2D unit thickness): a ``PlaneWall`` in the
   engine's ``"boundary"`` servo mode (``M a = F_target - F_wall``, seed 003 eq 3.6) with a
   small mass ``wall_mass_ratio`` x the pad slab mass and no damping, so its time-mean
   force is the target (PFC's gain servo cannot follow the pad after 47 m/s asperity
   impacts; see docs/braking.md);
+- pad backing (``backing``): ``"absorbing"`` (default) ties the pad's top layer to the rest
+  of the pad (the 10-20 mm of friction material and its steel back plate the cell omits)
+  by Lysmer-Kuhlemeyer dashpots: normal ``rho c_p`` relative to the pressure plate and
+  shear ``rho c_s`` relative to the support (vx = 0) per unit area, so stress waves leave
+  the cell instead of reflecting from a free back face as tension; ``"support"`` is the
+  former rigid x-hold (FIX_X) with a free face in y;
 - optional uniform temperature boundary from a curve (section 3.2 eq 13, figure 9).
 """
 
@@ -43,6 +49,12 @@ DISC, PAD = 1, 2  # particle groups
 PHI0 = 0.35  # area fraction of the random placement
 PHI_TARGET = 0.82  # area fraction of the particle count before the stress adjustment
 MASS_SCALE = 1.0e4  # density multiplier during compaction only (geometry only is kept)
+
+#: areal mass (kg/m^2) of what the cell omits above the pad: the seed gives no pad or
+#: back-plate size; assumed 15 mm of Cu-PM friction material (5250 kg/m^3) on a 6 mm steel
+#: back plate (7850 kg/m^3), typical of high-power (railway) disc-brake pads:
+#: 15e-3 x 5250 + 6e-3 x 7850 = 126 kg/m^2, ~270 x the default 108 um pad slab of the cell
+PLATE_AREAL_MASS = 126.0
 
 #: micro-parameters (E_c Pa, kratio) from ``tribodem calibrate`` (full, 8 specimens), see
 #: docs/braking.md "Results": table 1 E and nu within 1.1% in tribodem's assembly
@@ -108,6 +120,7 @@ class Interface:
     phi: dict[int, float]
     target_force: float
     stats: dict[str, float] = field(default_factory=dict)
+    backing: PadBacking | None = None
 
     @property
     def width(self) -> float:
@@ -217,16 +230,63 @@ def _pairs_periodic(pos: np.ndarray, radius: np.ndarray, width: float, gap: floa
     return i[keep], j[keep], g[keep]
 
 
+class PadBacking:
+    """Non-reflecting (Lysmer-Kuhlemeyer) backing of the pad's top layer (an engine
+    ``Interaction``): the rest of the pad as a semi-infinite elastic medium.
+
+    Each anchored pad particle i of tributary area ``A = W t / n`` (m^2) gets
+    ``F_y = -rho c_p A (v_y - v_plate)`` and ``F_x = -rho c_s A v_x`` (N), with the pad's
+    table 1 density and the plane-strain wave speeds of its table 1 E and nu. The plate
+    feels the reaction of the normal dashpots (momentum is conserved); the shear dashpots
+    react on the support. The plate's total force on the pad (contact + dashpots) is
+    ``force`` (N, +: pushing the pad down)."""
+
+    def __init__(self, sim: Simulation, wall: PlaneWall, idx: np.ndarray, spec: MaterialSpec,
+                 width: float) -> None:
+        e, nu, rho = spec.young, spec.poisson, spec.density
+        c_p = math.sqrt(e * (1 - nu) / (rho * (1 + nu) * (1 - 2 * nu)))
+        c_s = math.sqrt(e / (2 * rho * (1 + nu)))
+        area = width * spec.thickness / max(idx.size, 1)
+        self.idx = idx
+        self.wall = wall
+        self.c_n = rho * c_p * area  # N s/m per particle
+        self.c_t = rho * c_s * area
+        self.target = float(wall.target_force)
+        self.reaction = 0.0  # N, the dashpots' push on the plate (+: up, against the load)
+        self.c_p, self.c_s = c_p, c_s
+
+    def compute(self, sim: Simulation) -> None:
+        """Add the dashpot forces; set the plate's drive to target minus their reaction."""
+        v = sim.p.vel[self.idx]
+        dv = v[:, 1] - float(self.wall.velocity[1])
+        sim.ext_force[self.idx, 1] -= self.c_n * dv
+        sim.ext_force[self.idx, 0] -= self.c_t * v[:, 0]
+        self.reaction = float(self.c_n * dv.sum())
+        self.wall.target_force = self.target - self.reaction
+
+    @property
+    def force(self) -> float:
+        """Total force of the plate on the pad now (N): wall contacts + dashpots."""
+        return float(self.wall.normal_force + self.reaction)
+
+
 def build_interface(geometry: Geometry, pressure_Pa: float, micro: str = "calibrated",
                     wall_mass_ratio: float = 0.05, dt_safety: float = 0.3,
-                    local_damping: float = 0.0) -> Interface:
+                    local_damping: float = 0.0, backing: str = "absorbing",
+                    plate_areal_mass: float | None = None) -> Interface:
     """Build the figure 8 interface (see the module docstring) with the pressure target
-    ``pressure_Pa x width x thickness`` (N). Particles start at rest; ``start_sliding``
+    ``pressure_Pa x width x thickness`` (N). The plate's mass is ``plate_areal_mass``
+    (kg/m^2) x W x t when given (the omitted pad and back plate), else
+    ``wall_mass_ratio`` x the cell's pad mass. Particles start at rest; ``start_sliding``
     sets the disc moving, the pressure plate then applies the pad."""
     if not pressure_Pa > 0:
         raise ValueError(f"pressure_Pa = {pressure_Pa!r}: must be > 0 Pa")
-    if not 0 < wall_mass_ratio <= 10:
-        raise ValueError(f"wall_mass_ratio = {wall_mass_ratio!r}: must be in (0, 10]")
+    if not 0 < wall_mass_ratio <= 1000:
+        raise ValueError(f"wall_mass_ratio = {wall_mass_ratio!r}: must be in (0, 1000]")
+    if plate_areal_mass is not None and not plate_areal_mass > 0:
+        raise ValueError(f"plate_areal_mass = {plate_areal_mass!r}: must be > 0 kg/m^2")
+    if backing not in ("absorbing", "support"):
+        raise ValueError(f"backing = {backing!r}: must be 'absorbing' or 'support'")
     disc, pad = materials(micro)
     rmax = max(disc.radius_range[1], pad.radius_range[1])
     geometry.check(rmax)
@@ -274,14 +334,17 @@ def build_interface(geometry: Geometry, pressure_Pa: float, micro: str = "calibr
     top = float((pos[pd, 1] + radii[pd]).max())
     anchor_disc = (~pd) & (pos[:, 1] - radii < bottom + dm)
     anchor_pad = pd & (pos[:, 1] + radii > top - dm)
-    fixed = np.where(anchor_disc, FIX_X | FIX_Y, 0) | np.where(anchor_pad, FIX_X, 0)
+    pad_fix = FIX_X if backing == "support" else 0
+    fixed = np.where(anchor_disc, FIX_X | FIX_Y, 0) | np.where(anchor_pad, pad_fix, 0)
     dens = np.where(pd, pad.density, disc.density)
     part = ParticleState(dim=2, pos=pos, radius=radii, density=dens, thickness=disc.thickness,
                          mat=np.where(pd, 1, 0), group=group, fixed=fixed)
     target = pressure_Pa * w * disc.thickness
     pad_mass = float((dens[pd] * math.pi * radii[pd] ** 2).sum() * disc.thickness)
+    plate_mass = (wall_mass_ratio * pad_mass if plate_areal_mass is None
+                  else plate_areal_mass * w * disc.thickness)
     wall = PlaneWall([0.0, top, 0.0], [0.0, -1.0, 0.0], material=1, mode="boundary",
-                     target_force=target, servo_mass=wall_mass_ratio * pad_mass,
+                     target_force=target, servo_mass=plate_mass,
                      name="pressure")
     margin = 4.0 * rmax + 2.0 * g.amplitude
     box = Box([0.0, bottom - margin, 0.0], [w, top + margin, 0.0], [True, False, False])
@@ -294,14 +357,19 @@ def build_interface(geometry: Geometry, pressure_Pa: float, micro: str = "calibr
                           pick(disc.tensile_strength, pad.tensile_strength),
                           pick(disc.cohesion, pad.cohesion))
     sim.add_interaction(bonds)
+    back = None
+    if backing == "absorbing":
+        back = PadBacking(sim, wall, np.flatnonzero(anchor_pad), pad, w)
+        sim.add_interaction(back)
     stats.update({"removed_by_cut": float(keep.size - keep.sum() + (~ok).sum()),
                   "particles": float(part.n), "bonds": float(bonds.n_bonds),
                   "bonds_per_particle": 2.0 * bonds.n_bonds / part.n,
-                  "profile_lift_m": lift, "packing_fraction": phi_c})
+                  "profile_lift_m": lift, "packing_fraction": phi_c,
+                  "pad_mass_kg": pad_mass, "plate_mass_kg": plate_mass})
     phi = {DISC: phi_c, PAD: phi_c}
     return Interface(sim=sim, bonds=bonds, wall=wall, disc=disc, pad=pad, geometry=g,
                      anchor_disc=anchor_disc, anchor_pad=anchor_pad, phi=phi,
-                     target_force=target, stats=stats)
+                     target_force=target, stats=stats, backing=back)
 
 
 def cross_contacts(iface: Interface) -> int:
@@ -320,3 +388,12 @@ def start_sliding(iface: Interface, speed_m_s: float) -> None:
     p.vel[d, 0] = -speed_m_s
     p.vel[iface.anchor_disc, 1] = 0.0
     p.vel[iface.anchor_pad, 0] = 0.0
+
+
+def plate_force(iface: Interface) -> float:
+    """Total force (N) the pressure plate applies to the pad now: wall contacts plus the
+    backing dashpots' reaction (absorbing backing)."""
+    if iface.backing is not None:
+        return iface.backing.force
+    return float(iface.wall.normal_force)
+

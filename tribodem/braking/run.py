@@ -21,7 +21,15 @@ import numpy as np
 
 from tribodem.braking.conditions import SEED_BRAKING_TIME_S, pressure_to_load, speed_to_rpm
 from tribodem.braking.measure import Reference, force_chains, measure, reference
-from tribodem.braking.model import DISC, PAD, Geometry, Interface, build_interface, start_sliding
+from tribodem.braking.model import (
+    DISC,
+    PAD,
+    Geometry,
+    Interface,
+    build_interface,
+    plate_force,
+    start_sliding,
+)
 from tribodem.dem.thermal import Thermal, read_curve
 from tribodem.io.results import write_csv, write_json
 from tribodem.io.vtk import write_lines, write_points, write_pvd
@@ -44,6 +52,8 @@ class RunSetup:
     samples: int = 100
     vtk_snapshots: int = 6
     wall_mass_ratio: float = 0.05
+    backing: str = "absorbing"
+    plate_areal_mass: float | None = None
     local_damping: float = 0.0
     dt_safety: float = 0.3
     thermal_curve: Path | None = None
@@ -52,15 +62,16 @@ class RunSetup:
 
 
 class _WallMean:
-    """An engine interaction that only averages the pressure wall's normal force (N)."""
+    """An engine interaction that only averages the plate's force on the pad (N): wall
+    contacts plus the backing dashpots' reaction."""
 
     def __init__(self, iface: Interface) -> None:
-        self.wall = iface.wall
+        self.iface = iface
         self.total = 0.0
         self.n = 0
 
     def compute(self, sim: Any) -> None:
-        self.total += self.wall.normal_force
+        self.total += plate_force(self.iface)
         self.n += 1
 
     @property
@@ -140,7 +151,8 @@ def run_braking(setup: RunSetup, out: Path | None = None) -> dict[str, Any]:
                          "'simulated' or 'stretched'")
     t_wall = time.perf_counter()
     iface = build_interface(setup.geometry, setup.pressure_Pa, setup.micro,
-                            setup.wall_mass_ratio, setup.dt_safety, setup.local_damping)
+                            setup.wall_mass_ratio, setup.dt_safety, setup.local_damping,
+                            setup.backing, setup.plate_areal_mass)
     t_build = time.perf_counter() - t_wall
     sim = iface.sim
     n0 = sim.p.n
@@ -168,8 +180,8 @@ def run_braking(setup: RunSetup, out: Path | None = None) -> dict[str, Any]:
         t = sim.time - t0
         slid = setup.speed_m_s * t
         row = {"time_s": t, "sliding_distance_m": slid,
-               "wall_force_N": iface.wall.normal_force,
-               "wall_pressure_Pa": iface.wall.normal_force / (iface.width * iface.disc.thickness),
+               "wall_force_N": plate_force(iface),
+               "wall_pressure_Pa": plate_force(iface) / (iface.width * iface.disc.thickness),
                "wall_displacement_m": float(iface.wall.point[1]) - wall_y0,
                "kinetic_energy_J": sim.kinetic_energy()}
         row.update(measure(iface, ref, slid))
@@ -234,6 +246,10 @@ def run_braking(setup: RunSetup, out: Path | None = None) -> dict[str, Any]:
         "particles_final": int(inside.sum()),
         "bonds_initial": iface.bonds.n_bonds,
         "target_force_N": iface.target_force,
+        "backing": setup.backing,
+        "plate_areal_mass_kg_m2": setup.plate_areal_mass,
+        "plate_mass_kg": iface.stats["plate_mass_kg"],
+        "plate_travel_m": wall_y0 - float(iface.wall.point[1]),
         "mean_wall_force_N": wall_mean.mean,
         "mean_wall_pressure_Pa": wall_mean.mean / (iface.width * iface.disc.thickness),
         "mean_wall_pressure_ratio": wall_mean.mean / iface.target_force,
@@ -288,12 +304,18 @@ def _assumptions(setup: RunSetup) -> list[str]:
         "is not reached; wear_depth_mean_extrapolated_8s_m extrapolates the steady wear "
         "rate (slope over the second half of the run) linearly in time = in sliding "
         "distance at constant speed; it is an extrapolation, not a simulation",
-        "pressure wall: a pressure plate (engine 'boundary' servo, seed 003 eq 3.6) of mass "
-        f"{setup.wall_mass_ratio} x the pad slab mass, no damping while sliding: its mean "
-        "force equals the target by momentum balance; the pad may lose contact after "
-        "asperity impacts and is pressed back by the load (intermittent contact)",
+        "pressure wall: a pressure plate (engine 'boundary' servo, seed 003 eq 3.6), no "
+        "damping, of mass " + (
+            f"{setup.plate_areal_mass} kg/m^2 x W x t (the omitted pad and back plate: 15 mm "
+            "Cu-PM + 6 mm steel assumed, the seed gives no sizes)"
+            if setup.plate_areal_mass else
+            f"{setup.wall_mass_ratio} x the cell's pad mass") +
+        "; its mean force tends to the target by momentum balance",
         "disc: anchored bottom layer fixed in y and driven at -v in x, the rest of the disc "
-        "starts at -v; pad: top layer held in x (support wall)",
+        "starts at -v; pad: top layer " + (
+            "tied to the rest of the pad by non-reflecting (Lysmer) dashpots, rho c_p "
+            "relative to the plate in y and rho c_s in x (the support)"
+            if setup.backing == "absorbing" else "held in x (support wall), free face in y"),
         "rough surfaces: independent random profiles (sine modes W/1..W/modes) cut from one "
         "compacted block; pad lowered vertically to first contact",
         "wear depth = detached solid area / (packing fraction x width), pad (the seed "

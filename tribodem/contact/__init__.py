@@ -1,7 +1,8 @@
 """First-body contact solvers (DESIGN.md "The fretting FE-DE model"; seed 003 ch. 3, 5, 6).
 
 One interface, :class:`FirstBodySolver`, driven through fretting cycles by
-:class:`FrettingCycle`; backend :class:`HalfSpaceSolver` (elastic half-space BEM on tamaas).
+:class:`FrettingCycle`; backends :class:`HalfSpaceSolver` (elastic half-space BEM on tamaas)
+and :class:`ElastoPlasticSolver` (tamaas EPIC, bilinear EN24T).
 """
 
 from tribodem.contact.base import (
@@ -15,6 +16,12 @@ from tribodem.contact.base import (
     contact_modulus,
     cycle_offsets,
     dundurs_beta,
+)
+from tribodem.contact.elastoplastic import (
+    ElastoPlasticSolver,
+    PlasticStep,
+    PlasticSubsurfaceStress,
+    bilinear_hardening,
 )
 from tribodem.contact.geometry import (
     HeightMap,
@@ -34,14 +41,18 @@ __all__ = [
     "VOIGT_ORDER",
     "CycleResult",
     "ElasticBody",
+    "ElastoPlasticSolver",
     "FirstBodySolver",
     "FrettingCycle",
     "HalfSpaceSolver",
     "HeightMap",
     "HertzSphere",
     "IncrementResult",
+    "PlasticStep",
+    "PlasticSubsurfaceStress",
     "SubsurfaceStress",
     "WindowTooSmallError",
+    "bilinear_hardening",
     "contact_modulus",
     "crossed_cylinders",
     "cycle_offsets",

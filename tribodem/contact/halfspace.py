@@ -33,6 +33,7 @@ import math
 import numpy as np
 import tamaas as tm
 from numpy.typing import NDArray
+from scipy.signal import fftconvolve
 
 from tribodem.contact.base import (
     BODIES,
@@ -147,6 +148,7 @@ class HalfSpaceSolver(FirstBodySolver):
         c = np.arange(-self.n + 1, self.n) * self.dx
         xe, ye = np.meshgrid(c, c, indexing="ij")
         self._kernel = _cell_integral(xe, ye, self.dx)  # int over a cell of 1/r, m
+        self.set_debris_pressure(None)
         self.reset()
 
     def reset(self) -> None:
@@ -161,6 +163,49 @@ class HalfSpaceSolver(FirstBodySolver):
         # normal solution (model traction) last found at each offset: the initial guess when
         # that offset comes back (next cycle's geometry differs only by one cycle's wear)
         self._warm: dict[float, NDArray[np.float64]] = {}
+
+    def set_debris_pressure(self, pressure: NDArray[np.float64] | None) -> None:
+        """Prescribe the debris (third-body) pressure on the window, Pa [n, n] (None clears).
+
+        Seed 003 section 3.2.7 (forces mapped back): the debris load acts on both bodies;
+        their elastic displacement under it, u_d = (1 / (pi E*)) int p_d / r dA (exact cell
+        integrals, not periodic), opens the gap, and the solid-solid contact carries the rest
+        of the load, ``load - debris_load``. Kept until cleared (``reset`` keeps it too).
+        """
+        n = self.n
+        if pressure is None:
+            self.debris_pressure = np.zeros((n, n))
+            self.debris_load = 0.0
+            self._debris_u = np.zeros((n, n))
+            return
+        pd = np.asarray(pressure, dtype=float)
+        if pd.shape != (n, n) or not np.all(np.isfinite(pd)) or pd.min() < 0:
+            raise ValueError(f"debris pressure: shape {pd.shape}, min {np.nanmin(pd):.3g}: "
+                             f"must be finite, >= 0 Pa, shape ({n}, {n})")
+        load = float(pd.sum() * self.dx**2)
+        if load >= self.load:
+            raise ValueError(f"debris load {load:.4g} N >= applied load {self.load:.4g} N: "
+                             "the solid-solid contact would carry nothing")
+        self.debris_pressure, self.debris_load = pd.copy(), load
+        u = fftconvolve(pd, self._kernel, mode="full")[n - 1 : 2 * n - 1, n - 1 : 2 * n - 1]
+        self._debris_u = u / (math.pi * self.modulus)
+
+    def loaded_solution(
+        self, offset: float = 0.0, debris: bool = False
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """(pressure Pa, gap m) of the normal contact at ``offset`` under the full load,
+        without (``debris=False``) or with the prescribed debris pressure (the returned
+        pressure is then solid + debris). Leaves the cycle's load history untouched."""
+        if not debris:
+            return self._normal(self.gap(offset), self.load, self._model_star)
+        p, gap = self._normal(self.gap(offset) + self._debris_u, self.solid_load,
+                              self._model_star)
+        return p + self.debris_pressure, gap
+
+    @property
+    def solid_load(self) -> float:
+        """Load carried by the solid-solid contact: applied minus debris load, N."""
+        return self.load - self.debris_load
 
     def approach(self, pressure: NDArray[np.float64], gap: NDArray[np.float64]) -> float:
         """True (non-periodic) half-space rigid approach d of a solution, m.
@@ -236,12 +281,12 @@ class HalfSpaceSolver(FirstBodySolver):
                 self._rev_traction = self._traction.copy()
                 self._slip_acc[:] = 0.0
             self._direction = new_dir
-        g = self.gap(offset)
+        g = self.gap(offset) + self._debris_u
         key = round(offset / self.dx, 9)
         warm = self._warm.get(key)
         if warm is not None:
             self._model.traction[:] = warm
-        p, gap = self._normal(g, self.load)
+        p, gap = self._normal(g, self.solid_load)
         if key in self._warm or len(self._warm) < _WARM_STARTS:
             self._warm[key] = np.array(self._model.traction, dtype=float)
         self._check_window(p, offset)
@@ -290,7 +335,7 @@ class HalfSpaceSolver(FirstBodySolver):
             return qx, acc, np.zeros(p.shape, dtype=bool)
         if travel == 0.0:
             return self._rev_traction.copy(), np.zeros_like(p), p > 0
-        p_star, gap_star = self._reduced(g, d_star, self.load, d)
+        p_star, gap_star = self._reduced(g, d_star, self.solid_load, d)
         qx = self._rev_traction - s * f * mu * (p - p_star)
         qx = np.clip(qx, -mu * p, mu * p)
         acc = np.where(p > 0, f * mu * self.kappa * gap_star, 0.0)

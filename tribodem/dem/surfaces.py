@@ -25,7 +25,7 @@ import numpy as np
 from numba import prange
 
 from tribodem.dem.jit import kernel
-from tribodem.dem.walls import PlaneWall, wall_contact
+from tribodem.dem.walls import PlaneWall, rigid_surface_contact
 
 SIDES = ("below", "above")
 
@@ -81,23 +81,9 @@ def heightmap_contacts(pos, vel, omega, radius, mass, inertia, mat, heights, x0,
             touching[i, 2] = 0.0
             continue
         point = (pos[i, 0], pos[i, 1], zs)
-        hit, f0, f1, f2, t0, t1, t2, delta, fn, energy, kn = wall_contact(
-            pos[i, 0], pos[i, 1], pos[i, 2], vel[i, 0], vel[i, 1], vel[i, 2], omega[i, 0],
-            omega[i, 1], omega[i, 2], radius[i], mass[i], inertia[i], mat[i], point, nrm,
-            svel, smat, hist[i], pairtab, elin, 3, 1.0, dt)
-        touching[i, 0] = delta
-        touching[i, 1] = fn
-        touching[i, 2] = kn
-        if hit:
-            ext_force[i, 0] -= f0
-            ext_force[i, 1] -= f1
-            ext_force[i, 2] -= f2
-            ext_torque[i, 0] += t0
-            ext_torque[i, 1] += t1
-            ext_torque[i, 2] += t2
-            fout[i, 0] = f0
-            fout[i, 1] = f1
-            fout[i, 2] = f2
+        rigid_surface_contact(i, pos, vel, omega, radius[i], mass, inertia, mat, point, nrm,
+                              svel, smat, hist, pairtab, elin, dt, touching, ext_force,
+                              ext_torque, fout)
 
 
 @dataclass

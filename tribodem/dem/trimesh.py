@@ -36,7 +36,7 @@ from numba import njit, prange
 
 from tribodem.dem.integrate import BLOCK
 from tribodem.dem.jit import kernel
-from tribodem.dem.walls import PlaneWall, wall_contact
+from tribodem.dem.walls import PlaneWall, rigid_surface_contact
 
 FACE, EDGE, VERTEX = 0, 1, 2
 
@@ -217,28 +217,15 @@ def trimesh_contacts(pos, vel, omega, radius, mass, inertia, mat, tri, tnorm, of
                 continue
             point = (bx + off[0], by + off[1], bz + off[2])
             nrm = (n0, n1, n2)
-            hit, f0, f1, f2, t0, t1, t2, delta, fn, energy, kn = wall_contact(
-                pos[i, 0], pos[i, 1], pos[i, 2], vel[i, 0], vel[i, 1], vel[i, 2], omega[i, 0],
-                omega[i, 1], omega[i, 2], r, mass[i], inertia[i], mat[i], point, nrm, svel,
-                smat, hist[i], pairtab, elin, 3, 1.0, dt)
-            touching[i, 0] = delta
-            touching[i, 1] = fn
-            touching[i, 2] = kn
+            hit, f0, f1, f2 = rigid_surface_contact(
+                i, pos, vel, omega, r, mass, inertia, mat, point, nrm, svel, smat, hist,
+                pairtab, elin, dt, touching, ext_force, ext_torque, fout)
             if hit:
-                ext_force[i, 0] -= f0
-                ext_force[i, 1] -= f1
-                ext_force[i, 2] -= f2
-                ext_torque[i, 0] += t0
-                ext_torque[i, 1] += t1
-                ext_torque[i, 2] += t2
-                fout[i, 0] = f0
-                fout[i, 1] = f1
-                fout[i, 2] = f2
                 bsum[blk, 0] += f0
                 bsum[blk, 1] += f1
                 bsum[blk, 2] += f2
                 bsum[blk, 3] += 1.0
-                bsum[blk, 4] += kn
+                bsum[blk, 4] += touching[i, 2]
             else:
                 fout[i, 0] = 0.0
                 fout[i, 1] = 0.0

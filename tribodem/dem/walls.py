@@ -134,6 +134,34 @@ def wall_contact(x0, x1, x2, v0, v1, v2, w0, w1, w2, r, m, inertia, mat_i, point
     return True, f0, f1, f2, t0, t1, t2, delta, fn, energy, kn
 
 
+@njit(cache=True, inline="always")
+def rigid_surface_contact(i, pos, vel, omega, r, mass, inertia, mat, point, nrm, svel, smat,
+                          hist, pairtab, elin, dt, touching, ext_force, ext_torque, fout):
+    """Contact of particle i (3D) with a rigid surface through its local tangent plane
+    (``point``, unit ``nrm`` towards the particle): the wall law (``wall_contact``); adds
+    the particle's force/torque into ``ext_force``/``ext_torque``, writes the force on the
+    surface ``fout[i]`` and ``touching[i]`` = (overlap m, normal force N, kn N/m).
+    Returns (touching, force on the surface (3, N))."""
+    hit, f0, f1, f2, t0, t1, t2, delta, fn, energy, kn = wall_contact(
+        pos[i, 0], pos[i, 1], pos[i, 2], vel[i, 0], vel[i, 1], vel[i, 2], omega[i, 0],
+        omega[i, 1], omega[i, 2], r, mass[i], inertia[i], mat[i], point, nrm, svel, smat,
+        hist[i], pairtab, elin, 3, 1.0, dt)
+    touching[i, 0] = delta
+    touching[i, 1] = fn
+    touching[i, 2] = kn
+    if hit:
+        ext_force[i, 0] -= f0
+        ext_force[i, 1] -= f1
+        ext_force[i, 2] -= f2
+        ext_torque[i, 0] += t0
+        ext_torque[i, 1] += t1
+        ext_torque[i, 2] += t2
+        fout[i, 0] = f0
+        fout[i, 1] = f1
+        fout[i, 2] = f2
+    return hit, f0, f1, f2
+
+
 def wall_arrays(walls: list[PlaneWall]) -> tuple[np.ndarray, ...]:
     """Point, normal, velocity (nw, 3) and material (nw,) arrays of the walls for kernels."""
     nw = len(walls)

@@ -8,10 +8,13 @@ from tribodem.fretting.criteria import (
     CRITERIA,
     Criterion,
     CriterionUnavailable,
+    DFDICriterion,
+    SWTCriterion,
     ThresholdCriterion,
     TrackGrid,
     column_search,
     make_criterion,
+    swt_life,
 )
 from tribodem.fretting.loop import RESULT_COLUMNS, FrettingHistory, FrettingLoop, WornSurface
 
@@ -21,11 +24,14 @@ __all__ = [
     "RESULT_COLUMNS",
     "Criterion",
     "CriterionUnavailable",
+    "DFDICriterion",
     "FrettingHistory",
     "FrettingLoop",
+    "SWTCriterion",
     "ThresholdCriterion",
     "TrackGrid",
     "WornSurface",
     "column_search",
     "make_criterion",
+    "swt_life",
 ]

@@ -12,7 +12,7 @@ from typing import Annotated, Any, Literal
 import typer
 from pydantic import BaseModel, ConfigDict, Field, field_validator
 
-from tribodem.contact import ElasticBody, HalfSpaceSolver, crossed_cylinders
+from tribodem.contact import ElasticBody, ElastoPlasticSolver, HalfSpaceSolver, crossed_cylinders
 from tribodem.cyclejump import STRATEGIES, make_strategy
 from tribodem.fretting.criteria import (
     ALPHA_SEED,
@@ -23,8 +23,14 @@ from tribodem.fretting.criteria import (
     CriterionUnavailable,
     make_criterion,
 )
+from tribodem.fretting.debris import DebrisField, DebrisSettings
 from tribodem.fretting.loop import FrettingHistory, FrettingLoop
-from tribodem.fretting.output import write_figures, write_results, write_vtk_surfaces
+from tribodem.fretting.output import (
+    write_debris_outputs,
+    write_figures,
+    write_results,
+    write_vtk_surfaces,
+)
 from tribodem.io.config import ConfigError, dump_toml, load_toml, merge, validate
 from tribodem.io.results import write_text
 
@@ -77,11 +83,48 @@ class WearConfig(_Model):
     stress_depth: float | None = Field(None, gt=0, description="subsurface grid depth, m")
     stress_nz: int = Field(33, ge=2, le=257, description="subsurface grid levels")
     stress_samples: int = Field(8, ge=1, description="sampled increments per cycle")
+    eps0: float = Field(0.132, gt=0, description="dfdi: uniaxial failure strain eps0 (eq 6.2)")
+    swt_nz: int = Field(17, ge=2, le=129, description="swt: subsurface levels")
+    swt_plane_step: float = Field(5.0, gt=0, le=90, description="swt: candidate planes, deg")
+
+
+class PlasticConfig(_Model):
+    """``solver = "elastic-plastic"``: tamaas EPIC, bilinear EN24T (seed table 5.1)."""
+
+    yield_strength: float = Field(680e6, gt=0, description="initial yield, Pa")
+    uts: float = Field(1000e6, gt=0, description="ultimate tensile strength, Pa")
+    uts_strain: float = Field(0.132, gt=0, lt=1, description="engineering strain at UTS")
+    hardening: float | None = Field(None, ge=0, description="h, Pa (None: bilinear)")
+    ep_n: int = Field(32, ge=8, le=256, description="EP grid points per side (even)")
+    ep_nz: int = Field(12, ge=3, le=64, description="EP grid layers")
+    ep_window_radii: float = Field(5.0, gt=0, description="EP window, Hertz radii")
+    ep_depth_radii: float = Field(2.0, gt=0, description="EP depth, Hertz radii")
+    load_steps: int = Field(4, ge=1, le=100, description="first-loading steps")
+    ep_tolerance: float = Field(1e-6, gt=0, lt=0.1, description="EPIC tolerance")
 
 
 class JumpConfig(_Model):
     strategy: JumpName = "none"
     params: dict[str, Any] = Field(default_factory=dict)
+
+
+class DebrisConfig(_Model):
+    """The debris third body (seed 003 3.2.6-3.2.7); off unless ``every`` is set."""
+
+    every: int | None = Field(None, ge=1, description="DE phase every K cycles (None: off)")
+    diameter: float = Field(0.6e-6, gt=0, description="debris diameter d of eq 3.10, m")
+    shares: tuple[float, float, float] = Field(
+        (1 / 3, 1 / 3, 1 / 3), description="spherical, chunk, rubbing fractions")
+    volume_correction: float = Field(1.0, gt=0, le=2, description="seed's 0.77 (optional)")
+    cor: float = Field(0.72, gt=0, le=1)
+    friction: float = Field(0.6, ge=0)
+    rolling_friction: float = Field(0.001, ge=0)
+    density_scaling: float = Field(1.0, ge=1, description="DE-phase mass scaling")
+    tolerance: float = Field(1e-4, gt=0, lt=0.1, description="servo relative load error")
+    max_steps: int = Field(200_000, ge=100, description="DE steps per phase at most")
+    ramp_steps: int = Field(10_000, ge=0, description="servo target ramp, steps")
+    target_cap: float = Field(0.9, gt=0, lt=1, description="debris load <= cap x load")
+    seed: int = 0
 
 
 class OutputConfig(_Model):
@@ -97,10 +140,13 @@ class FrettingConfig(_Model):
     contact: ContactConfig = Field(default_factory=ContactConfig)
     wear: WearConfig = Field(default_factory=WearConfig)
     jump: JumpConfig = Field(default_factory=JumpConfig)
+    plastic: PlasticConfig = Field(default_factory=PlasticConfig)
+    debris: DebrisConfig = Field(default_factory=DebrisConfig)
     output: OutputConfig = Field(default_factory=OutputConfig)
 
 
-QUICK: dict[str, Any] = {"cycles": 10, "contact": {"n": 64}, "wear": {"stress_nz": 17}}
+QUICK: dict[str, Any] = {"cycles": 10, "contact": {"n": 64}, "wear": {"stress_nz": 17},
+                         "debris": {"ramp_steps": 4000}}
 
 
 def build_criterion(cfg: FrettingConfig) -> Criterion:
@@ -114,6 +160,10 @@ def build_criterion(cfg: FrettingConfig) -> Criterion:
         "s22": {"yield_strength": w.yield_strength, **stress},
         "von_mises": {"yield_strength": w.yield_strength, **stress},
         "shear": {"uts": w.uts, **stress},
+        "dfdi": {"eps0": w.eps0, "depth": w.stress_depth},
+        "swt": {"nz": w.swt_nz, "depth": w.stress_depth, "samples": w.stress_samples,
+                "plane_step": w.swt_plane_step, "young": cfg.contact.young,
+                "poisson": cfg.contact.poisson},
     }.get(name, {})
     try:
         return make_criterion(name, **params)
@@ -125,30 +175,50 @@ def build_criterion(cfg: FrettingConfig) -> Criterion:
 
 def build_loop(cfg: FrettingConfig) -> FrettingLoop:
     """Solver + criterion + strategy from a validated config (``ConfigError`` if unusable)."""
-    if cfg.solver == "elastic-plastic":
+    if cfg.wear.criterion == "dfdi" and cfg.solver != "elastic-plastic":
         raise ConfigError(
-            "solver = 'elastic-plastic' is not implemented yet (needs tamaas EPICSolver with "
-            "bilinear EN24T hardening); use solver = 'elastic'"
+            f"wear.criterion = 'dfdi' with solver = {cfg.solver!r}: DFDI (eqs 6.1-6.2) needs "
+            "the equivalent plastic strain; allowed: solver = 'elastic-plastic'"
         )
     crit = build_criterion(cfg)
     c = cfg.contact
     mat = ElasticBody(young=c.young, poisson=c.poisson)
     try:
         upper, lower = crossed_cylinders(c.diameter)
-        solver = HalfSpaceSolver(upper, lower, load=c.load, friction=c.friction,
-                                 upper_material=mat, lower_material=mat, n=c.n,
-                                 window=c.window, regime=c.regime, tolerance=c.tolerance)
+        common: dict[str, Any] = dict(
+            load=c.load, friction=c.friction, upper_material=mat, lower_material=mat,
+            n=c.n, window=c.window, regime=c.regime, tolerance=c.tolerance)
+        if cfg.solver == "elastic-plastic":
+            pc = cfg.plastic
+            solver: HalfSpaceSolver = ElastoPlasticSolver(
+                upper, lower, yield_strength=pc.yield_strength, hardening=pc.hardening,
+                uts=pc.uts, uts_strain=pc.uts_strain, ep_n=pc.ep_n, ep_nz=pc.ep_nz,
+                ep_window_radii=pc.ep_window_radii, ep_depth_radii=pc.ep_depth_radii,
+                load_steps=pc.load_steps, ep_tolerance=pc.ep_tolerance, **common)
+        else:
+            solver = HalfSpaceSolver(upper, lower, **common)
     except ValueError as err:
         raise ConfigError(f"contact: {err}") from None
     strategy = None
     if cfg.jump.strategy != "none":
         try:
-            strategy = make_strategy(cfg.jump.strategy, **cfg.jump.params)
+            params = dict(cfg.jump.params)
+            if cfg.jump.strategy == "adaptive":  # decide on the worn volume (docs/fretting.md)
+                params.setdefault("decide_on", "total")
+            strategy = make_strategy(cfg.jump.strategy, **params)
         except (TypeError, ValueError) as err:
             raise ConfigError(f"jump.params for '{cfg.jump.strategy}': {err}") from None
+    debris = None
+    if cfg.debris.every is not None:
+        dc = cfg.debris.model_dump(exclude={"every"})
+        try:
+            debris = DebrisField(DebrisSettings(young=c.young, poisson=c.poisson, **dc))
+        except ValueError as err:
+            raise ConfigError(str(err)) from None
     try:
         return FrettingLoop(solver, crit, amplitude=c.amplitude, n_increments=c.n_increments,
-                            strategy=strategy)
+                            strategy=strategy, debris=debris,
+                            debris_every=cfg.debris.every or 1)
     except ValueError as err:
         raise ConfigError(f"wear: {err}") from None
 
@@ -186,6 +256,9 @@ def run_fretting(cfg: FrettingConfig, out: Path, echo: Any = None) -> dict[str, 
         files += [p.name for p in write_figures(hist, out)]
     if cfg.output.vtk:
         files += [p.name for p in write_vtk_surfaces(hist, out)]
+    if hist.de_phases:
+        files += [p.name for p in write_debris_outputs(hist, out, figures=cfg.output.figures,
+                                                       vtk=cfg.output.vtk)]
     extra = {
         "criterion": {"name": loop.criterion.name, "kind": loop.criterion.kind,
                       **loop.criterion.params()},
@@ -224,6 +297,11 @@ def run_cmd(
         "--jump", help=f"none or one of: {', '.join(STRATEGIES)}.")] = None,
     solver: Annotated[str | None, typer.Option(
         "--solver", help="elastic or elastic-plastic.")] = None,
+    debris_every: Annotated[int | None, typer.Option(
+        "--debris-every", help="Debris third body: a DE phase every K cycles.")] = None,
+    no_debris: Annotated[bool, typer.Option(
+        "--no-debris", help="Switch the debris third body off (overrides the config).")
+    ] = False,
     quick: Annotated[bool, typer.Option("--quick", help="64^2 grid, 10 cycles.")] = False,
 ) -> None:
     """Run the fretting wear loop; writes results.csv, summary.json, figures, VTK to --out."""
@@ -236,6 +314,12 @@ def run_cmd(
         ov.setdefault("jump", {})["strategy"] = jump
     if solver is not None:
         ov["solver"] = solver
+    if debris_every is not None and no_debris:
+        raise ConfigError("--debris-every and --no-debris: give one of them, not both")
+    if debris_every is not None:
+        ov.setdefault("debris", {})["every"] = debris_every
+    if no_debris:
+        ov.setdefault("debris", {})["every"] = None
     cfg = resolve_config(config, quick=quick, overrides=ov)
     summary = run_fretting(cfg, out, echo=typer.echo)
     typer.echo(

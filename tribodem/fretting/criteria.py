@@ -18,9 +18,9 @@ Two kinds:
   search with linear interpolation (section 6.3, figure 6.4; :func:`column_search`):
   ``s22`` (|sigma_zz| >= yield), ``von_mises`` (>= yield), ``shear`` (in-plane shear
   D = tau / (0.8 UTS) >= 1, eq 6.9, tau = sqrt(sigma_xz^2 + sigma_yz^2) on planes parallel
-  to the surface). ``dfdi`` (eqs 6.1-6.2) needs plastic strain and ``swt`` (eqs 6.3-6.8)
-  a Miner sum per material point: both are registered and refuse to run with a message
-  naming what is missing.
+  to the surface). ``dfdi`` (eqs 6.1-6.2, DFDI >= 1, needs the elastic-plastic solver's
+  plastic strain; refused with an elastic one) and ``swt`` (eqs 6.3-6.8, critical plane
+  SWT, Miner sum D >= 1) accumulate damage per material point across cycles.
 """
 
 from __future__ import annotations
@@ -384,36 +384,315 @@ class ShearCriterion(ThresholdCriterion):
         return {**super().params(), "uts_Pa": self.uts}
 
 
-class _Unavailable(Criterion):
-    reason: ClassVar[str] = ""
+def _shift_up(field: NDArray[np.float64], z: NDArray[np.float64],
+              removed: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Damage field ``[nz, ...]`` on depths below the surface after removing ``removed`` (m)
+    of material from each column: new(z) = old(z + removed), zero below the grid."""
+    if not np.any(removed > 0):
+        return field
+    nz = field.shape[0]
+    flat = field.reshape(nz, -1)
+    h = removed.reshape(-1)
+    dz = z[1] - z[0]
+    q = (z[:, None] + h[None, :]) / dz  # fractional level index of the material now at z
+    k = np.floor(q).astype(int)
+    w = q - k
+    cols = np.arange(flat.shape[1])[None, :]
+    k0 = np.clip(k, 0, nz - 1)
+    k1 = np.clip(k + 1, 0, nz - 1)
+    out = (1 - w) * flat[k0, cols] + w * flat[k1, cols]
+    out[k >= nz - 1] = 0.0
+    return out.reshape(field.shape)
 
-    def __init__(self, **kw: Any) -> None:
-        raise CriterionUnavailable(f"criterion '{self.name}' cannot run: {self.reason}")
 
-    def add_increment(self, index: int, inc: IncrementResult) -> None:  # pragma: no cover
-        raise NotImplementedError
+class DFDICriterion(Criterion):
+    """Ductile failure damage indicator (seed eqs 6.1-6.2), threshold DFDI >= 1.
 
-    def depths(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:  # pragma: no cover
-        raise NotImplementedError
-
-
-class DFDICriterion(_Unavailable):
-    """Ductile failure damage indicator (seed eqs 6.1-6.2): needs plastic strain."""
+    DFDI = sum over the plastic load steps of dp / eps_f (eq 6.1, p the equivalent
+    (cumulated) plastic strain), eps_f = 1.65 eps0 exp(-3 sigma_m / (2 sigma_eq)) (eq 6.2,
+    sigma_m mean stress, sigma_eq von Mises, both at the end of the step). Accumulated over
+    cycles per material point on a [nz, ...] grid under each body (the damaged layer moves
+    up as wear removes material); wear depth by :func:`column_search` at DFDI = 1.
+    ``eps0`` default 0.132 (engineering strain at the UTS implied by seed table 6.2's
+    1000 -> 1132 MPa conversion; the seed gives no number). Needs a solver that exposes
+    ``pop_plastic_steps()`` (:class:`tribodem.contact.ElastoPlasticSolver`).
+    """
 
     name = "dfdi"
     kind = "threshold"
-    reason = ("it needs the equivalent plastic strain (eqs 6.1-6.2), which only an "
-              "elastic-plastic first-body solver provides; the elastic-plastic solver "
-              "(tamaas EPICSolver) is not implemented yet")
+
+    def __init__(self, eps0: float = 0.132, depth: float | None = None, nz: int = 33) -> None:
+        if not (math.isfinite(eps0) and eps0 > 0):
+            raise ValueError(f"eps0 = {eps0!r} is not allowed: must be > 0 (failure strain)")
+        if depth is not None and not (math.isfinite(depth) and depth > 0):
+            raise ValueError(f"depth = {depth!r} is not allowed: must be > 0 m (or None)")
+        if int(nz) != nz or nz < 2:
+            raise ValueError(f"nz = {nz!r} is not allowed: must be an integer >= 2")
+        self.eps0 = float(eps0)
+        self.depth = depth
+        self.nz = int(nz)
+        self._d_up: NDArray[np.float64] | None = None
+        self._d_lo: NDArray[np.float64] | None = None
+        self._last_info: dict[str, Any] = {}
+
+    @staticmethod
+    def check_solver(solver: object) -> None:
+        """Refuse a solver without plastic strain (eqs 6.1-6.2 need it)."""
+        if not callable(getattr(solver, "pop_plastic_steps", None)):
+            raise CriterionUnavailable(
+                "criterion 'dfdi' needs the equivalent plastic strain (eqs 6.1-6.2): use the "
+                "elastic-plastic solver (solver = 'elastic-plastic'); "
+                f"{type(solver).__name__} is elastic"
+            )
+
+    def failure_strain(self, stress: NDArray[np.float64]) -> NDArray[np.float64]:
+        """eps_f of eq 6.2 for Voigt stresses [..., 6] (xx, yy, zz, yz, xz, xy), -."""
+        s = np.asarray(stress, dtype=float)
+        sm = s[..., :3].mean(-1)
+        dev = s[..., :3] - sm[..., None]
+        seq = np.sqrt(1.5 * (dev**2).sum(-1) + 3.0 * (s[..., 3:] ** 2).sum(-1))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            tri = np.where(seq > 0, sm / seq, 0.0)
+        return 1.65 * self.eps0 * np.exp(-1.5 * tri)
+
+    def damage_increment(self, dp: NDArray[np.float64],
+                         stress: NDArray[np.float64]) -> NDArray[np.float64]:
+        """dDFDI = dp / eps_f (eq 6.1) of one step, [...]."""
+        return np.asarray(dp, dtype=float) / self.failure_strain(stress)
+
+    def begin_cycle(self, grid: TrackGrid, solver: FirstBodySolver) -> None:
+        self.check_solver(solver)
+        super().begin_cycle(grid, solver)
+        if self.depth is None:
+            self.depth = float(solver.ep_depth)  # type: ignore[attr-defined]
+        self._z = np.linspace(0.0, self.depth, self.nz)
+        if self._d_up is None:
+            self._d_up = np.zeros((self.nz, grid.n, grid.n))
+            self._d_lo = np.zeros((self.nz, grid.n_track, grid.n))
+
+    def add_increment(self, index: int, inc: IncrementResult) -> None:
+        """Plastic flow happens in the solver's load steps (collected in ``depths``)."""
+
+    def depths(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        from scipy.interpolate import RegularGridInterpolator
+
+        assert self._d_up is not None and self._d_lo is not None
+        g = self.grid
+        steps = self.solver.pop_plastic_steps()  # type: ignore[attr-defined]
+        if steps:
+            dd = sum(self.damage_increment(st.dp, st.stress) for st in steps)
+            c = steps[0].x
+            interp = RegularGridInterpolator((steps[0].z, c, c), dd, bounds_error=False,
+                                             fill_value=0.0)
+            zz, xx, yy = np.meshgrid(self._z, g.x_upper, g.y, indexing="ij")
+            field = interp(np.stack([zz, xx, yy], -1))
+            # both bodies carry the same plastic state (same traction, same material);
+            # the EP solve is at offset 0: upper window frame, lower track at shift 0
+            self._d_up += field
+            self._d_lo[:, g.pad : g.pad + g.n, :] += field
+        du, su = column_search(self._d_up, self._z, 1.0)
+        dl, sl = column_search(self._d_lo, self._z, 1.0)
+        self._last_info = {
+            "max_dfdi_upper": float(self._d_up.max()),
+            "max_dfdi_lower": float(self._d_lo.max()),
+            "saturated_columns_upper": int(su.sum()),
+            "saturated_columns_lower": int(sl.sum()),
+            "grid_depth_m": float(self._z[-1]),
+        }
+        self._d_up = _shift_up(self._d_up, self._z, du)
+        self._d_lo = _shift_up(self._d_lo, self._z, dl)
+        return du, dl
+
+    def info(self) -> dict[str, Any]:
+        return dict(self._last_info)
+
+    def params(self) -> dict[str, Any]:
+        return {"eps0": self.eps0, "depth_m": self.depth, "nz": self.nz}
 
 
-class SWTCriterion(_Unavailable):
-    """Smith-Watson-Topper critical plane with Miner's sum (seed eqs 6.3-6.8)."""
+#: Seed table 6.2 (SWT, Mitchell method): b, sigma'_f (Pa), sigma_T (Pa), eps'_f, c.
+SWT_TABLE_6_2 = {"b": -0.103, "sigma_f": 2349e6, "sigma_t": 1132e6, "eps_f": 1.22, "c": -0.6}
+
+
+def swt_rhs(two_n: NDArray[np.float64] | float, young: float, b: float, sigma_f: float,
+            eps_f: float, c: float) -> NDArray[np.float64]:
+    """Right side of eq 6.3: sigma_f'^2 / E (2N)^2b + sigma_f' eps_f' (2N)^(b+c), Pa."""
+    x = np.asarray(two_n, dtype=float)
+    return sigma_f**2 / young * x ** (2 * b) + sigma_f * eps_f * x ** (b + c)
+
+
+def swt_life(swt: NDArray[np.float64] | float, young: float = 240e9,
+             b: float = SWT_TABLE_6_2["b"], sigma_f: float = SWT_TABLE_6_2["sigma_f"],
+             eps_f: float = SWT_TABLE_6_2["eps_f"], c: float = SWT_TABLE_6_2["c"]
+             ) -> NDArray[np.float64]:
+    """Cycles to crack initiation N_i solving eq 6.3 for SWT (Pa), inverted by bisection on
+    ln(2N) (the right side decreases with N for b, c < 0). SWT <= 0 gives inf; SWT above
+    the 2N = 1 value gives N = 0.5."""
+    if not (b < 0 and c < 0):
+        raise ValueError(f"b = {b!r}, c = {c!r} are not allowed: both exponents must be < 0")
+    s = np.atleast_1d(np.asarray(swt, dtype=float))
+    out = np.full(s.shape, np.inf)
+    top = float(swt_rhs(1.0, young, b, sigma_f, eps_f, c))
+    pos = s > 0
+    lo = np.zeros(s.shape)
+    hi = np.full(s.shape, 200.0)  # ln(2N) <= 200: N up to ~1e86
+    for _ in range(80):
+        mid = 0.5 * (lo + hi)
+        big = swt_rhs(np.exp(mid), young, b, sigma_f, eps_f, c) > s
+        lo = np.where(big, mid, lo)
+        hi = np.where(big, hi, mid)
+    n = 0.5 * np.exp(0.5 * (lo + hi))
+    out[pos] = np.where(s[pos] >= top, 0.5, n[pos])
+    return out.reshape(np.shape(swt))
+
+
+def plane_normals(step_deg: float = 5.0) -> NDArray[np.float64]:
+    """Candidate plane normals n(theta, phi) of eq 6.4, theta and phi in [0, 180) deg by
+    ``step_deg``, [n_planes, 3]."""
+    ang = np.deg2rad(np.arange(0.0, 180.0, step_deg))
+    th, ph = np.meshgrid(ang, ang, indexing="ij")
+    n = np.stack([np.sin(th) * np.cos(ph), np.sin(th) * np.sin(ph), np.cos(th)], -1)
+    return n.reshape(-1, 3)
+
+
+def critical_plane_swt(history: NDArray[np.float64], young: float, poisson: float,
+                       normals: NDArray[np.float64], chunk: int = 2048) -> NDArray[np.float64]:
+    """Maximum over candidate planes of SWT = sigma_max Delta eps / 2 (eqs 6.3, 6.5-6.6), Pa.
+
+    ``history`` [T, P, 6]: Voigt stresses (xx, yy, zz, yz, xz, xy, Pa) of P points at T
+    instants. On each plane sigma_n(t) = n.sigma.n (eq 6.5) and the elastic normal strain
+    eps_n = ((1 + nu) sigma_n - nu tr sigma) / E (eq 6.6 with Hooke's law); sigma_max =
+    max_t sigma_n, Delta eps = max_t eps_n - min_t eps_n; planes with sigma_max <= 0 give 0.
+    """
+    h = np.asarray(history, dtype=float)
+    nx, ny, nzv = normals[:, 0], normals[:, 1], normals[:, 2]
+    proj = np.stack([nx * nx, ny * ny, nzv * nzv, 2 * ny * nzv, 2 * nx * nzv, 2 * nx * ny])
+    out = np.zeros(h.shape[1])
+    for i in range(0, h.shape[1], chunk):
+        c = h[:, i : i + chunk]
+        sn = c @ proj  # [T, C, planes]
+        tr = c[..., :3].sum(-1)[..., None]
+        en = ((1 + poisson) * sn - poisson * tr) / young
+        smax = sn.max(0)
+        de = en.max(0) - en.min(0)
+        out[i : i + chunk] = np.where(smax > 0, 0.5 * smax * de, 0.0).max(-1)
+    return out
+
+
+class SWTCriterion(ThresholdCriterion):
+    """Smith-Watson-Topper critical plane with Miner's sum (seed eqs 6.3-6.8), D >= 1.
+
+    Per material point: the stress history of the cycle (``samples`` increments), SWT on
+    the critical plane among 5 deg candidate planes (eqs 6.4-6.6), N_i from eq 6.3 with
+    table 6.2 constants (b -0.103, sigma_f' 2349 MPa, eps_f' 1.22, c -0.6; E 240 GPa,
+    nu 0.3), Miner damage D += 1/N_i per cycle (eq 6.8). Wear where D >= 1 by
+    :func:`column_search`; ``info()`` projects the cycles to first wear per body at the
+    current damage rate. The lower body's history is taken on the track (nearest shift;
+    zero stress where the window is elsewhere). Strain: elastic (Hooke) of the stress.
+    """
 
     name = "swt"
-    kind = "threshold"
-    reason = ("the SWT critical-plane criterion (eqs 6.3-6.8: 5 deg planes, Miner sum per "
-              "material point, table 6.2 constants) is not implemented yet")
+    unit = "-"
+
+    def __init__(self, young: float = 240e9, poisson: float = 0.3, b: float = -0.103,
+                 sigma_f: float = 2349e6, eps_f: float = 1.22, c: float = -0.6,
+                 plane_step: float = 5.0, nz: int = 17, **kw: Any) -> None:
+        if not (math.isfinite(young) and young > 0):
+            raise ValueError(f"young = {young!r} is not allowed: must be > 0 Pa")
+        if not (-1 < poisson < 0.5):
+            raise ValueError(f"poisson = {poisson!r} is not allowed: must be in (-1, 0.5)")
+        if not (0 < plane_step <= 90):
+            raise ValueError(f"plane_step = {plane_step!r} is not allowed: must be in (0, 90] deg")
+        if not (sigma_f > 0 and eps_f > 0 and b < 0 and c < 0):
+            raise ValueError("SWT constants not allowed: need sigma_f > 0, eps_f > 0, b < 0, c < 0")
+        super().__init__(1.0, nz=nz, **kw)
+        self.young, self.poisson = float(young), float(poisson)
+        self.consts = {"b": b, "sigma_f": sigma_f, "eps_f": eps_f, "c": c}
+        self.plane_step = float(plane_step)
+        self.normals = plane_normals(plane_step)
+        self._d_up: NDArray[np.float64] | None = None
+        self._d_lo: NDArray[np.float64] | None = None
+        self.cycles_done = 0
+
+    def field(self, st: SubsurfaceStress) -> NDArray[np.float64]:  # pragma: no cover
+        return st.stress
+
+    def begin_cycle(self, grid: TrackGrid, solver: FirstBodySolver) -> None:
+        Criterion.begin_cycle(self, grid, solver)
+        if self._n_increments == 0:
+            raise RuntimeError("set_increments() must be called before the first cycle")
+        self._idx = sorted(self.sample_indices())
+        s = len(self._idx)
+        self._h_up = np.zeros((s, self.nz, grid.n, grid.n, 6), dtype=np.float32)
+        self._h_lo = np.zeros((s, self.nz, grid.n_track, grid.n, 6), dtype=np.float32)
+        self._z = None
+        if self._d_up is None:
+            self._d_up = np.zeros((self.nz, grid.n, grid.n))
+            self._d_lo = np.zeros((self.nz, grid.n_track, grid.n))
+
+    def add_increment(self, index: int, inc: IncrementResult) -> None:
+        if index not in self._idx:
+            return
+        k = self._idx.index(index)
+        depth = self._depth_for(inc)
+        g = self.grid
+        for body in ("upper", "lower"):
+            st = self.solver.subsurface_stress(inc, body, depth=depth, nz=self.nz)
+            self._z = st.z
+            if body == "upper":
+                self._h_up[k] = st.stress
+            else:
+                j0 = g.pad + int(round(inc.offset / g.dx))
+                self._h_lo[k, :, j0 : j0 + g.n, :] = st.stress
+
+    def damage_rate(self, history: NDArray[np.float64]) -> NDArray[np.float64]:
+        """1 / N_i per cycle of a history [T, ...spatial, 6] (eqs 6.3-6.6), shape [...]."""
+        h = np.asarray(history, dtype=float)
+        shape = h.shape[1:-1]
+        flat = h.reshape(h.shape[0], -1, 6)
+        amp = np.abs(flat).max(axis=(0, 2))
+        keep = amp > 1e-6 * max(float(amp.max(initial=0.0)), 1e-300)
+        swt = np.zeros(flat.shape[1])
+        swt[keep] = critical_plane_swt(flat[:, keep], self.young, self.poisson, self.normals)
+        n = swt_life(swt, self.young, **self.consts)
+        return (1.0 / n).reshape(shape)
+
+    def depths(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        assert self._z is not None, "no sampled increment in this cycle"
+        assert self._d_up is not None and self._d_lo is not None
+        r_up = self.damage_rate(self._h_up)
+        r_lo = self.damage_rate(self._h_lo)
+        self._d_up = self._d_up + r_up
+        self._d_lo = self._d_lo + r_lo
+        self.cycles_done += 1
+        du, su = column_search(self._d_up, self._z, 1.0)
+        dl, sl = column_search(self._d_lo, self._z, 1.0)
+
+        def first_wear(d: NDArray[np.float64], r: NDArray[np.float64]) -> float:
+            if np.any(d >= 1.0):
+                return float(self.cycles_done)
+            with np.errstate(divide="ignore"):
+                left = np.where(r > 0, (1.0 - d) / r, np.inf)
+            return float(self.cycles_done + left.min())
+
+        self._last_info = {
+            "cycles_to_first_wear_upper": first_wear(self._d_up, r_up),
+            "cycles_to_first_wear_lower": first_wear(self._d_lo, r_lo),
+            "max_damage_rate_upper": float(r_up.max()),
+            "max_damage_rate_lower": float(r_lo.max()),
+            "miner_sum_max_upper": float(self._d_up.max()),
+            "miner_sum_max_lower": float(self._d_lo.max()),
+            "saturated_columns_upper": int(su.sum()),
+            "saturated_columns_lower": int(sl.sum()),
+            "grid_depth_m": float(self._z[-1]),
+        }
+        self._d_up = _shift_up(self._d_up, self._z, du)
+        self._d_lo = _shift_up(self._d_lo, self._z, dl)
+        return du, dl
+
+    def params(self) -> dict[str, Any]:
+        return {**super().params(), "young_Pa": self.young, "poisson": self.poisson,
+                **self.consts, "plane_step_deg": self.plane_step}
 
 
 CRITERIA: dict[str, type[Criterion]] = {

@@ -30,6 +30,7 @@ from tribodem.contact.geometry import HeightMap, Recession
 from tribodem.contact.halfspace import WindowTooSmallError
 from tribodem.cyclejump import JumpStrategy
 from tribodem.fretting.criteria import Criterion, ThresholdCriterion, TrackGrid
+from tribodem.fretting.debris import DebrisField, DEPhaseResult, debris_target, run_de_phase
 
 #: Columns of ``results.csv`` (one row per simulated or jumped cycle).
 RESULT_COLUMNS = (
@@ -43,6 +44,14 @@ RESULT_COLUMNS = (
     "max_pressure_Pa",
     "max_traction_Pa",
     "contact_area_m2",
+)
+#: Extra columns when the debris third body is on (seed 003 sections 3.2.6-3.2.7).
+DEBRIS_COLUMNS = (
+    "debris_particles",
+    "debris_load_fraction",
+    "max_pressure_with_debris_Pa",
+    "load_balance_error",
+    "de_phase",
 )
 
 
@@ -74,6 +83,8 @@ class FrettingHistory:
     wall_time_s: float = 0.0
     stopped: str | None = None  #: reason the run stopped early (None: completed)
     criterion_info: dict[str, Any] = field(default_factory=dict)
+    de_phases: list[DEPhaseResult] = field(default_factory=list)  #: debris DE phases run
+    debris: DebrisField | None = None
 
     @property
     def cumulative_energy(self) -> float:
@@ -103,7 +114,19 @@ class FrettingHistory:
             "dissipated_energy_total_J": self.cumulative_energy,
             "grid": {"n": self.grid.n, "dx_m": self.grid.dx, "n_track": self.grid.n_track},
             "criterion_last_cycle": self.criterion_info,
+            **({"debris": self.debris_summary()} if self.debris is not None else {}),
         }
+
+    def debris_summary(self) -> dict[str, Any]:
+        """Debris totals: mass balance, particles, DE phases (servo error, steps, time)."""
+        d = self.debris
+        assert d is not None
+        phases = [ph.summary() for ph in self.de_phases]
+        return {"particles_in_contact": d.n, "particles_created": d.created,
+                "particles_ejected": d.ejected, **d.mass_balance(),
+                "volume_rel_error": (d.created_volume - d.settings.volume_correction
+                                     * d.worn_volume) / max(d.worn_volume, 1e-300),
+                "de_phases": phases}
 
 
 def _scar_mean(w: NDArray[np.float64]) -> float:
@@ -129,6 +152,8 @@ class FrettingLoop:
         amplitude: float = 0.3e-3,
         n_increments: int = 48,
         strategy: JumpStrategy | None = None,
+        debris: DebrisField | None = None,
+        debris_every: int = 1,
     ) -> None:
         if not (hasattr(solver, "upper") and hasattr(solver, "lower")):
             raise TypeError("solver must expose its surfaces as .upper and .lower recessions")
@@ -145,6 +170,41 @@ class FrettingLoop:
         self.base_lower: Recession = solver.lower  # type: ignore[attr-defined]
         self.wear_upper = np.zeros((n, n))
         self.wear_lower = np.zeros((self.grid.n_track, n))
+        if debris is not None and not hasattr(solver, "set_debris_pressure"):
+            raise TypeError("debris needs a solver with set_debris_pressure (HalfSpaceSolver)")
+        if int(debris_every) != debris_every or debris_every < 1:
+            raise ValueError(f"debris_every = {debris_every!r}: must be an integer >= 1 cycle")
+        self.debris = debris
+        self.debris_every = int(debris_every)
+        self.de_phases: list[DEPhaseResult] = []
+        self._cycle = 0
+        self._p_load = np.zeros((n, n))  # total pressure at the loading position, Pa
+
+    def _de_phase(self) -> dict[str, float]:
+        """Seed 003 figure 3.1 DE step: load the debris, map its forces back to the solver."""
+        d, sol = self.debris, self.solver
+        assert d is not None
+        c = sol.coords
+        target = debris_target(d, self._p_load, c, sol.dx, sol.load)  # type: ignore[attr-defined]
+        if target <= 0.0:
+            sol.set_debris_pressure(None)  # type: ignore[attr-defined]
+            return {"de_phase": 0}
+        xw, yw = np.meshgrid(c, c, indexing="ij")
+        lower = np.asarray(sol.lower(xw, yw), dtype=float)  # type: ignore[attr-defined]
+        p_without, gap = sol.loaded_solution(0.0)  # type: ignore[attr-defined]
+        res = run_de_phase(d, lower, gap, c, target, cycle=self._cycle)
+        sol.set_debris_pressure(res.pressure)  # type: ignore[attr-defined]
+        res.pressure_without = p_without
+        res.pressure_with = sol.loaded_solution(0.0, debris=True)[0]  # type: ignore[attr-defined]
+        self.de_phases.append(res)
+        return {"de_phase": 1}
+
+    def _generate_debris(self, du: NDArray[np.float64], dl: NDArray[np.float64]) -> None:
+        if self.debris is None:
+            return
+        g = self.grid
+        self.debris.generate(self._cycle, [(du, g.x_upper, g.y), (dl, g.x_lower, g.y)],
+                             g.cell_area)
 
     def _apply_geometry(self) -> None:
         g = self.grid
@@ -163,12 +223,27 @@ class FrettingLoop:
         self.wear_lower = s[k:].reshape(self.wear_lower.shape).copy()
 
     def simulate_cycle(self) -> dict[str, float]:
-        """One cycle on the current surfaces; adds its wear; returns per-cycle quantities."""
+        """One cycle on the current surfaces; adds its wear; returns per-cycle quantities.
+
+        With debris: every ``debris_every`` cycles a DE phase first (target from the last
+        loading-position pressure), its pressure kept by the solver for the cycle; the
+        cycle's worn volume becomes new debris (eq 3.10).
+        """
+        self._cycle += 1
         self._apply_geometry()
+        extra: dict[str, float] = {}
+        if self.debris is not None:
+            extra["de_phase"] = 0
+            if self._cycle % self.debris_every == 0 and self.debris.n > 0:
+                extra |= self._de_phase()
+        begin = getattr(self.solver, "begin_cycle", None)
+        if callable(begin):  # solver hook at cycle start (elastic-plastic solver)
+            begin()
         crit = self.criterion
         crit.begin_cycle(self.grid, self.solver)
         cell = self.grid.cell_area
-        energy = pmax = qmax = area = 0.0
+        energy = pmax = qmax = area = pmax_d = balance = 0.0
+        pd = getattr(self.solver, "debris_pressure", None)
         for i, s in enumerate(self.offsets):
             inc = self.solver.solve_increment(float(s))
             crit.add_increment(i, inc)
@@ -176,16 +251,31 @@ class FrettingLoop:
             pmax = max(pmax, inc.max_pressure)
             qmax = max(qmax, inc.max_traction)
             area += inc.contact_area
+            if self.debris is not None and pd is not None:
+                total = inc.pressure + pd
+                pmax_d = max(pmax_d, float(total.max()))
+                load = self.solver.load  # type: ignore[attr-defined]
+                balance = max(balance, abs(float(total.sum()) * cell - load) / load)
+                if s == 0.0:
+                    self._p_load = total
         du, dl = crit.depths()
         if np.any(du < 0) or np.any(dl < 0):
             raise RuntimeError(f"criterion '{crit.name}' returned a negative wear depth")
         self.wear_upper = self.wear_upper + du
         self.wear_lower = self.wear_lower + dl
+        self._generate_debris(du, dl)
+        if self.debris is not None:
+            load = self.solver.load  # type: ignore[attr-defined]
+            extra |= {"debris_particles": self.debris.n,
+                      "debris_load_fraction": float(self.solver.debris_load) / load,  # type: ignore[attr-defined]
+                      "max_pressure_with_debris_Pa": pmax_d,
+                      "load_balance_error": balance}
         return {
             "dissipated_energy_J": energy,
             "max_pressure_Pa": pmax,
             "max_traction_Pa": qmax,
             "contact_area_m2": area / len(self.offsets),
+            **extra,
         }
 
     def _row(self, cycle: int, jumped: bool, per_cycle: dict[str, float]) -> dict[str, Any]:
@@ -228,7 +318,9 @@ class FrettingLoop:
 
         self.solver.reset()
         self._apply_geometry()
-        self.solver.solve_increment(0.0)  # normal loading at offset 0
+        first = self.solver.solve_increment(0.0)  # normal loading at offset 0
+        self._p_load = first.pressure + getattr(self.solver, "debris_pressure", 0.0)
+        hist.debris = self.debris
         if self.strategy is not None:
             self.strategy.observe(0, self._state())
         c = 0
@@ -251,12 +343,21 @@ class FrettingLoop:
             new = np.asarray(self.strategy.extrapolate(old, n), dtype=float)
             new = np.maximum(new, old)  # wear never heals
             for k in range(1, n + 1):
+                prev = self._state()
                 self._set_state(old + (new - old) * (k / n))
+                self._cycle += 1
+                if self.debris is not None:
+                    dd = self._state() - prev
+                    ku = self.wear_upper.size
+                    self._generate_debris(dd[:ku].reshape(self.wear_upper.shape),
+                                          dd[ku:].reshape(self.wear_lower.shape))
+                    per = per | {"debris_particles": self.debris.n, "de_phase": 0}
                 record(self._row(c + k, True, per))
             c += n
             hist.cycles_jumped += n
         self._apply_geometry()  # the solver holds the final worn surfaces
         hist.wear_upper, hist.wear_lower = self.wear_upper, self.wear_lower
         hist.criterion_info = self.criterion.info()
+        hist.de_phases = self.de_phases
         hist.wall_time_s = time.perf_counter() - t0
         return hist

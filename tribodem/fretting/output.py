@@ -7,14 +7,14 @@ from typing import Any
 
 import numpy as np
 
-from tribodem.fretting.loop import RESULT_COLUMNS, FrettingHistory
+from tribodem.fretting.loop import DEBRIS_COLUMNS, RESULT_COLUMNS, FrettingHistory
 from tribodem.io.results import atomic_write, write_csv, write_figure, write_json
 
 
 def write_results(hist: FrettingHistory, out: Path, extra: dict[str, Any]) -> dict[str, Any]:
     """``out/results.csv`` (one row per cycle) and ``out/summary.json`` (totals + ``extra``)."""
-    write_csv(out / "results.csv", RESULT_COLUMNS,
-              ([r[c] for c in RESULT_COLUMNS] for r in hist.rows))
+    cols = RESULT_COLUMNS + (DEBRIS_COLUMNS if hist.debris is not None else ())
+    write_csv(out / "results.csv", cols, ([r.get(c, "") for c in cols] for r in hist.rows))
     summary = {**hist.summary(), **extra}
     write_json(out / "summary.json", summary)
     return summary
@@ -113,4 +113,70 @@ def write_vtk_surfaces(hist: FrettingHistory, out: Path) -> list[Path]:
         path = out / f"surface_{body}.vtu"
         atomic_write(path, lambda p, m=mesh: meshio.write(p, m, file_format="vtu"))
         paths.append(path)
+    return paths
+
+
+def write_debris_outputs(hist: FrettingHistory, out: Path, figures: bool = True,
+                         vtk: bool = True) -> list[Path]:
+    """Debris of each DE phase: ``debris_CCCC.vtu`` (particles with force, moved distance,
+    shape) and pictures like seed figs 5.19-5.27: the particle layer coloured by the force
+    on each particle, the distance moved in the loading step, the servo record, and the
+    contact pressure on the lower body at the central section without vs with debris."""
+    from tribodem.io.vtk import write_points
+
+    paths: list[Path] = []
+    for ph in hist.de_phases:
+        moved = np.linalg.norm(ph.positions - ph.start_positions, axis=1)
+        fmag = np.linalg.norm(ph.particle_force, axis=1)
+        paths.append(write_csv(
+            out / f"debris_servo_{ph.cycle:04d}.csv",
+            ("step", "upper_force_N", "lower_force_N", "upper_z_m", "target_N"),
+            ([int(h[0]), h[1], h[2], h[3], ph.target_N] for h in ph.history)))
+        if vtk:
+            paths.append(write_points(
+                out / f"debris_{ph.cycle:04d}.vtu", ph.positions,
+                {"radius_m": ph.radius, "force_on_lower_N": ph.particle_force,
+                 "force_N": fmag, "moved_m": moved}))
+    if not figures or not hist.de_phases:
+        return paths
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    ph = hist.de_phases[-1]
+    moved = np.linalg.norm(ph.positions - ph.start_positions, axis=1)
+    fmag = np.linalg.norm(ph.particle_force, axis=1)
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.5))
+    for ax, val, lab in ((axes[0], fmag * 1e3, "force on particle (mN)"),
+                         (axes[1], moved * 1e9, "moved distance (nm)")):
+        sc = ax.scatter(ph.positions[:, 0] * 1e3, ph.positions[:, 1] * 1e3, c=val, s=2,
+                        cmap="viridis")
+        fig.colorbar(sc, ax=ax, label=lab)
+        ax.set_aspect("equal")
+        ax.set_xlabel("x (mm)")
+        ax.set_ylabel("y (mm)")
+    axes[0].set_title(f"debris layer, cycle {ph.cycle}: {ph.particles} particles (figs 5.23/5.26)")
+    axes[1].set_title("distance moved in the loading step (figs 5.20/5.21)")
+    fig.tight_layout()
+    paths.append(write_figure(out / "debris_layer.png", fig))
+    g = hist.grid
+    j = g.n // 2
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4))
+    if ph.pressure_without is not None and ph.pressure_with is not None:
+        axes[0].plot(g.x_upper * 1e3, ph.pressure_without[:, j] / 1e6, label="without debris")
+        axes[0].plot(g.x_upper * 1e3, ph.pressure_with[:, j] / 1e6, label="with debris")
+        axes[0].plot(g.x_upper * 1e3, ph.pressure[:, j] / 1e6, ":", label="debris share")
+    axes[0].set_xlabel("x (mm)")
+    axes[0].set_ylabel("contact pressure on lower body (MPa)")
+    axes[0].set_title(f"central section, cycle {ph.cycle} (figs 5.22/5.24)")
+    axes[0].legend(fontsize=8)
+    for p in hist.de_phases:
+        axes[1].plot(p.history[:, 0], p.history[:, 1], label=f"cycle {p.cycle}")
+        axes[1].axhline(p.target_N, color="k", lw=0.5, ls="--")
+    axes[1].set_xlabel("DE step")
+    axes[1].set_ylabel("servo force on the debris (N); dashed: target")
+    axes[1].legend(fontsize=7)
+    fig.tight_layout()
+    paths.append(write_figure(out / "debris_pressure.png", fig))
     return paths
