@@ -166,4 +166,8 @@ def test_quick_coupled_cli_run(tmp_path) -> None:
     last = servo[-1]
     assert abs(float(last["upper_force_N"]) / float(last["target_N"]) - 1) < 1e-4
     assert (out / "debris_0002.vtu").exists() and (out / "debris_layer.png").exists()
+    from tribodem.io.stl import read_stl
+
+    tris = read_stl(out / "de_surface_upper_0002.stl")  # geometry exchange, as the seed did
+    assert tris.shape == (2 * 63 * 63, 3, 3)
     assert "--no-debris" in CliRunner().invoke(app, ["fretting", "run", "--help"]).output

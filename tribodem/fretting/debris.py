@@ -329,6 +329,11 @@ class DEPhaseResult:
     #: by the fretting loop: the same geometry solved both ways)
     pressure_without: NDArray[np.float64] | None = None
     pressure_with: NDArray[np.float64] | None = None
+    #: the rigid DE surfaces at equilibrium: grid coordinates (m) and lower / upper surface
+    #: elevations z (m) on coords x coords (for STL export, as the seed exchanged geometry)
+    coords: NDArray[np.float64] | None = None
+    lower_z: NDArray[np.float64] | None = None
+    upper_z: NDArray[np.float64] | None = None
 
     def summary(self) -> dict[str, Any]:
         """Scalars for JSON."""
@@ -471,6 +476,8 @@ def run_de_phase(field: DebrisField, lower: NDArray[np.float64], gap: NDArray[np
         loaded_particles=int((body_f[:, 2] < 0).sum()), pressure=pressure,
         history=np.array(hist), positions=final, start_positions=start,
         particle_force=body_f, radius=np.full(field.n, 0.5 * s.diameter),
+        coords=np.asarray(coords, float).copy(), lower_z=-np.asarray(lower, float),
+        upper_z=up_h + float(upper_s.point[2]),
         assumptions={"gravity": "left out (weight ~1e-14 N per particle)",
                      "density_scaling": s.density_scaling,
                      "first_bodies": "rigid height maps at offset 0 (loading position)",

@@ -122,9 +122,15 @@ def write_debris_outputs(hist: FrettingHistory, out: Path, figures: bool = True,
     shape) and pictures like seed figs 5.19-5.27: the particle layer coloured by the force
     on each particle, the distance moved in the loading step, the servo record, and the
     contact pressure on the lower body at the central section without vs with debris."""
+    from tribodem.io.stl import heightmap_to_triangles, write_stl
     from tribodem.io.vtk import write_points
 
     paths: list[Path] = []
+    last = hist.de_phases[-1] if hist.de_phases else None
+    if last is not None and last.coords is not None:
+        for body, z in (("lower", last.lower_z), ("upper", last.upper_z)):
+            tris = heightmap_to_triangles(last.coords, last.coords, z)
+            paths.append(write_stl(out / f"de_surface_{body}_{last.cycle:04d}.stl", tris))
     for ph in hist.de_phases:
         moved = np.linalg.norm(ph.positions - ph.start_positions, axis=1)
         fmag = np.linalg.norm(ph.particle_force, axis=1)
