@@ -43,7 +43,7 @@ from functools import cache
 import numpy as np
 from numba import njit, prange
 
-from tribodem.dem.integrate import BLOCK
+from tribodem.dem.integrate import BLOCK, local_damped
 from tribodem.dem.jit import kernel
 from tribodem.dem.neighbors import NeighborList, _reverse
 from tribodem.dem.space import min_image
@@ -360,25 +360,12 @@ def clump_advance(pos, vel, omega, force, torque, mstart, members, offsets, bmas
             t0 += torque[i, 0] + r1 * g2 - r2 * g1
             t1 += torque[i, 1] + r2 * g0 - r0 * g2
             t2 += torque[i, 2] + r0 * g1 - r1 * g0
-        if local > 0.0:
-            v = bvel[c, 0]
-            if v != 0.0:
-                f0 -= local * abs(f0) * (1.0 if v > 0.0 else -1.0)
-            v = bvel[c, 1]
-            if v != 0.0:
-                f1 -= local * abs(f1) * (1.0 if v > 0.0 else -1.0)
-            v = bvel[c, 2]
-            if v != 0.0:
-                f2 -= local * abs(f2) * (1.0 if v > 0.0 else -1.0)
-            v = bomega[c, 0]
-            if v != 0.0:
-                t0 -= local * abs(t0) * (1.0 if v > 0.0 else -1.0)
-            v = bomega[c, 1]
-            if v != 0.0:
-                t1 -= local * abs(t1) * (1.0 if v > 0.0 else -1.0)
-            v = bomega[c, 2]
-            if v != 0.0:
-                t2 -= local * abs(t2) * (1.0 if v > 0.0 else -1.0)
+        f0 = local_damped(f0, bvel[c, 0], local)
+        f1 = local_damped(f1, bvel[c, 1], local)
+        f2 = local_damped(f2, bvel[c, 2], local)
+        t0 = local_damped(t0, bomega[c, 0], local)
+        t1 = local_damped(t1, bomega[c, 1], local)
+        t2 = local_damped(t2, bomega[c, 2], local)
         inv_m = b / bmass[c]
         bvel[c, 0] = a * bvel[c, 0] + f0 * inv_m
         bvel[c, 1] = a * bvel[c, 1] + f1 * inv_m

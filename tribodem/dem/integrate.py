@@ -24,24 +24,26 @@ BLOCK = 256  # particles per block: fixed, so block sums do not depend on the th
 
 
 @njit(cache=True, inline="always")
+def local_damped(f, v, local):
+    """PFC local damping of one degree of freedom: ``f - alpha |f| sign(v)`` (N or N m)."""
+    if local > 0.0 and v != 0.0:
+        return f - local * abs(f) * (1.0 if v > 0.0 else -1.0)
+    return f
+
+
+@njit(cache=True, inline="always")
 def _update(pos, vel, omega, i, f, t, m, inertia, fixed, a, b, local, dt):
     """Central-difference update of particle i for force f and moment t (seed 000 eqs 4, 7)."""
     for k in range(3):
         if fixed & (1 << k):
             continue
-        fk = f[k]
         v = vel[i, k]
-        if local > 0.0 and v != 0.0:
-            fk -= local * abs(fk) * (1.0 if v > 0.0 else -1.0)
-        vel[i, k] = a * v + b * fk / m
+        vel[i, k] = a * v + b * local_damped(f[k], v, local) / m
     for k in range(3):
         if fixed & (1 << (k + 3)):
             continue
-        tk = t[k]
         w = omega[i, k]
-        if local > 0.0 and w != 0.0:
-            tk -= local * abs(tk) * (1.0 if w > 0.0 else -1.0)
-        omega[i, k] = a * w + b * tk / inertia
+        omega[i, k] = a * w + b * local_damped(t[k], w, local) / inertia
     for k in range(3):
         pos[i, k] += vel[i, k] * dt
 

@@ -23,9 +23,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from numba import prange
+from numpy.typing import NDArray
 
 from tribodem.dem.jit import kernel
-from tribodem.dem.walls import PlaneWall, rigid_surface_contact
+from tribodem.dem.walls import RigidSurface, rigid_surface_contact
 
 SIDES = ("below", "above")
 
@@ -86,8 +87,32 @@ def heightmap_contacts(pos, vel, omega, radius, mass, inertia, mat, heights, x0,
                               ext_torque, fout)
 
 
+def bilinear_weights(x: NDArray[np.float64], y: NDArray[np.float64], x0: float, y0: float,
+                     dx: float, dy: float, shape: tuple[int, int]
+                     ) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.float64]]:
+    """Node indices (i, j: [m, 4]) and weights ([m, 4]) of points in a regular grid.
+
+    For a value field this is seed 003 eq 3.15 (the shape function through the element's
+    four nodal values evaluated at (x, y)); points outside the grid get zero weights.
+    """
+    u = (np.asarray(x, float) - x0) / dx
+    v = (np.asarray(y, float) - y0) / dy
+    nx, ny = shape
+    iu = np.floor(u).astype(np.int64)
+    iv = np.floor(v).astype(np.int64)
+    inside = (iu >= 0) & (iv >= 0) & (iu < nx - 1) & (iv < ny - 1)
+    iu = np.clip(iu, 0, nx - 2)
+    iv = np.clip(iv, 0, ny - 2)
+    fu, fv = u - iu, v - iv
+    w = np.stack([(1 - fu) * (1 - fv), fu * (1 - fv), (1 - fu) * fv, fu * fv], axis=1)
+    w *= inside[:, None]
+    ii = np.stack([iu, iu + 1, iu, iu + 1], axis=1)
+    jj = np.stack([iv, iv, iv + 1, iv + 1], axis=1)
+    return ii, jj, w
+
+
 @dataclass
-class HeightMapSurface(PlaneWall):
+class HeightMapSurface(RigidSurface):
     """A rigid height-map surface (an ``Interaction``; add with ``sim.add_interaction``).
 
     ``heights[i, j]`` (m) is the surface elevation at ``(x0 + i dx, y0 + j dy)`` in the
@@ -104,7 +129,6 @@ class HeightMapSurface(PlaneWall):
     dx: float = 1.0
     dy: float = 1.0
     side: str = "below"
-    particle_force: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
 
     def __post_init__(self) -> None:
         if self.side not in SIDES:
@@ -123,33 +147,21 @@ class HeightMapSurface(PlaneWall):
                 raise ValueError(f"surface '{self.name}': {nm} = {getattr(self, nm)!r}: must "
                                  "be > 0 m")
         self.heights = h
-        self._hist = np.zeros((0, 3))
-        self._touch = np.zeros((0, 3))
+        self._contact_arrays(0)
 
     def elevation(self, x: np.ndarray, y: np.ndarray) -> np.ndarray:
         """Surface z (m) at lab (x, y) with the current displacement (NaN outside the grid)."""
-        u = (np.asarray(x, float) - self.point[0] - self.x0) / self.dx
-        v = (np.asarray(y, float) - self.point[1] - self.y0) / self.dy
-        nx, ny = self.heights.shape
-        iu = np.floor(u).astype(np.int64)
-        iv = np.floor(v).astype(np.int64)
-        ok = (iu >= 0) & (iv >= 0) & (iu < nx - 1) & (iv < ny - 1)
-        iu_, iv_ = np.clip(iu, 0, nx - 2), np.clip(iv, 0, ny - 2)
-        fu, fv = u - iu_, v - iv_
-        h = self.heights
-        z = ((1 - fu) * (1 - fv) * h[iu_, iv_] + fu * (1 - fv) * h[iu_ + 1, iv_]
-             + (1 - fu) * fv * h[iu_, iv_ + 1] + fu * fv * h[iu_ + 1, iv_ + 1])
-        return np.where(ok, z + self.point[2], np.nan)
+        ii, jj, w = bilinear_weights(np.asarray(x, float) - self.point[0],
+                                     np.asarray(y, float) - self.point[1], self.x0, self.y0,
+                                     self.dx, self.dy, self.heights.shape)
+        z = (self.heights[ii, jj] * w).sum(axis=1)
+        return np.where(w.any(axis=1), z + self.point[2], np.nan)
 
     def compute(self, sim) -> None:  # noqa: ANN001 - Simulation (engine protocol)
         """Move (servo on the force measured last step), then add the contact forces."""
         p = sim.p
         n = p.n
-        if self._hist.shape[0] != n:
-            self._hist = np.zeros((n, 3))
-            self._touch = np.zeros((n, 3))
-            self.particle_force = np.zeros((n, 3))
-        elif sim.step_count > 0:
+        if not self._contact_arrays(n) and sim.step_count > 0:
             self.update_motion(sim.dt)
         sgn = 1.0 if self.side == "below" else -1.0
         heightmap_contacts.pick(n)(
@@ -162,17 +174,3 @@ class HeightMapSurface(PlaneWall):
         hit = self._touch[:, 0] > 0.0
         self.contacts = int(hit.sum())
         self.stiffness = float(self._touch[hit, 2].sum())
-
-    def state(self) -> dict[str, np.ndarray]:
-        """Mutable state for checkpoints (motion and contact history)."""
-        s = super().state()
-        s["hist"] = self._hist.copy()
-        s["touch"] = self._touch.copy()
-        return s
-
-    def set_state(self, s: dict[str, np.ndarray]) -> None:
-        """Restore the state saved by ``state``."""
-        super().set_state(s)
-        self._hist = s["hist"].copy()
-        self._touch = s["touch"].copy()
-        self.particle_force = np.zeros_like(self._hist)

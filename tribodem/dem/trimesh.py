@@ -36,7 +36,7 @@ from numba import njit, prange
 
 from tribodem.dem.integrate import BLOCK
 from tribodem.dem.jit import kernel
-from tribodem.dem.walls import PlaneWall, rigid_surface_contact
+from tribodem.dem.walls import RigidSurface, rigid_surface_contact
 
 FACE, EDGE, VERTEX = 0, 1, 2
 
@@ -233,7 +233,7 @@ def trimesh_contacts(pos, vel, omega, radius, mass, inertia, mat, tri, tnorm, of
 
 
 @dataclass
-class TriangleSurface(PlaneWall):
+class TriangleSurface(RigidSurface):
     """A rigid triangle-mesh surface (an ``Interaction``; add with ``sim.add_interaction``).
 
     ``triangles`` (m, ``(n, 3, 3)``) in the surface frame, e.g. from
@@ -251,7 +251,6 @@ class TriangleSurface(PlaneWall):
     flip: bool = False
     reach: float | None = None
     path: Callable[[float], np.ndarray] | None = None
-    particle_force: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -271,8 +270,7 @@ class TriangleSurface(PlaneWall):
         if self.reach is not None and not self.reach > 0:
             raise ValueError(f"surface '{self.name}': reach = {self.reach!r}: must be > 0 m")
         self._grid: tuple[np.ndarray, ...] | None = None
-        self._hist = np.zeros((0, 3))
-        self._touch = np.zeros((0, 3))
+        self._contact_arrays(0)
         self._bsum = np.zeros((0, 5))
 
     def _build_grid(self, rmax: float) -> None:
@@ -298,11 +296,7 @@ class TriangleSurface(PlaneWall):
         n = p.n
         if p.dim != 3:
             raise ValueError(f"surface '{self.name}': triangle surfaces are 3D only")
-        fresh = self._hist.shape[0] != n
-        if fresh:
-            self._hist = np.zeros((n, 3))
-            self._touch = np.zeros((n, 3))
-            self.particle_force = np.zeros((n, 3))
+        fresh = self._contact_arrays(n)
         if not fresh or self.path is not None:
             self._move(sim)
         rmax = float(p.radius.max()) if n else 0.0
@@ -327,16 +321,3 @@ class TriangleSurface(PlaneWall):
         """The triangles at the current displacement (m), e.g. for ``write_stl``."""
         return self.triangles + self.point
 
-    def state(self) -> dict[str, np.ndarray]:
-        """Mutable state for checkpoints (motion and contact history)."""
-        s = super().state()
-        s["hist"] = self._hist.copy()
-        s["touch"] = self._touch.copy()
-        return s
-
-    def set_state(self, s: dict[str, np.ndarray]) -> None:
-        """Restore the state saved by ``state``."""
-        super().set_state(s)
-        self._hist = s["hist"].copy()
-        self._touch = s["touch"].copy()
-        self.particle_force = np.zeros_like(self._hist)

@@ -97,6 +97,37 @@ class PlaneWall:
         self.contacts = int(c)
 
 
+class RigidSurface(PlaneWall):
+    """A rigid body surface acting as an ``Interaction`` (height map, triangle mesh): a
+    :class:`PlaneWall` for its motion (``point`` = rigid displacement, ``normal`` = servo
+    direction towards the particles) plus per-particle contact state -- shear history
+    ``_hist``, ``_touch`` = (overlap m, normal force N, kn N/m) and ``particle_force`` (N,
+    on the surface) -- kept in checkpoints."""
+
+    def _contact_arrays(self, n: int) -> bool:
+        """(Re)allocate the per-particle arrays for ``n`` particles; True if they were."""
+        if getattr(self, "_hist", None) is not None and self._hist.shape[0] == n:
+            return False
+        self._hist = np.zeros((n, 3))
+        self._touch = np.zeros((n, 3))
+        self.particle_force = np.zeros((n, 3))
+        return True
+
+    def state(self) -> dict[str, np.ndarray]:
+        """Mutable state for checkpoints (motion and contact history)."""
+        s = super().state()
+        s["hist"] = self._hist.copy()
+        s["touch"] = self._touch.copy()
+        return s
+
+    def set_state(self, s: dict[str, np.ndarray]) -> None:
+        """Restore the state saved by ``state``."""
+        super().set_state(s)
+        self._hist = s["hist"].copy()
+        self._touch = s["touch"].copy()
+        self.particle_force = np.zeros_like(self._hist)
+
+
 @njit(cache=True, inline="always")
 def wall_contact(x0, x1, x2, v0, v1, v2, w0, w1, w2, r, m, inertia, mat_i, point, normal, wvel,
                  wmat, hist, pairtab, elin, dim, thickness, dt):

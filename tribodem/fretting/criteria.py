@@ -172,7 +172,35 @@ class Criterion(ABC):
         return {}
 
 
-class EnergyCriterion(Criterion):
+class RateCriterion(Criterion):
+    """A local rate law: each increment adds ``coefficient x local_rate(inc)`` (m) to the
+    wear depth of every point; the lower body gets the same field on its track."""
+
+    @property
+    @abstractmethod
+    def coefficient(self) -> float:
+        """Wear coefficient multiplying the accumulated field."""
+
+    @abstractmethod
+    def local_rate(self, inc: IncrementResult) -> NDArray[np.float64]:
+        """The increment's field on the window, [n, n]."""
+
+    def begin_cycle(self, grid: TrackGrid, solver: FirstBodySolver) -> None:
+        super().begin_cycle(grid, solver)
+        self._up = np.zeros((grid.n, grid.n))
+        self._lo = np.zeros((grid.n_track, grid.n))
+
+    def add_increment(self, index: int, inc: IncrementResult) -> None:
+        f = self.local_rate(inc)
+        self._up += f
+        self.grid.deposit(self._lo, f, inc)
+
+    def depths(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        c = self.coefficient
+        return c * self._up, c * self._lo
+
+
+class EnergyCriterion(RateCriterion):
     """Fouvry's energy law per surface point: dh = alpha e (m), e in J/m^2 (seed eq 2.7).
 
     Each body loses ``alpha`` times the interface energy dissipated on it (the density is
@@ -187,24 +215,18 @@ class EnergyCriterion(Criterion):
             raise ValueError(f"alpha = {alpha!r} is not allowed: must be finite and >= 0 m^3/J")
         self.alpha = float(alpha)
 
-    def begin_cycle(self, grid: TrackGrid, solver: FirstBodySolver) -> None:
-        super().begin_cycle(grid, solver)
-        self._up = np.zeros((grid.n, grid.n))
-        self._lo = np.zeros((grid.n_track, grid.n))
+    @property
+    def coefficient(self) -> float:
+        return self.alpha
 
-    def add_increment(self, index: int, inc: IncrementResult) -> None:
-        e = inc.energy_density
-        self._up += e
-        self.grid.deposit(self._lo, e, inc)
-
-    def depths(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        return self.alpha * self._up, self.alpha * self._lo
+    def local_rate(self, inc: IncrementResult) -> NDArray[np.float64]:
+        return inc.energy_density
 
     def params(self) -> dict[str, Any]:
         return {"alpha_m3_per_J": self.alpha}
 
 
-class ArchardCriterion(Criterion):
+class ArchardCriterion(RateCriterion):
     """Local Archard law (seed eq 2.6): dh = k p |ds| per increment, k in 1/Pa (m^2/N).
 
     Default k = alpha mu (1.641e-6 mm^3/J x 0.6): the same wear as ``energy`` in gross slip.
@@ -217,18 +239,12 @@ class ArchardCriterion(Criterion):
             raise ValueError(f"k = {k!r} is not allowed: must be finite and >= 0 (1/Pa)")
         self.k = float(k)
 
-    def begin_cycle(self, grid: TrackGrid, solver: FirstBodySolver) -> None:
-        super().begin_cycle(grid, solver)
-        self._up = np.zeros((grid.n, grid.n))
-        self._lo = np.zeros((grid.n_track, grid.n))
+    @property
+    def coefficient(self) -> float:
+        return self.k
 
-    def add_increment(self, index: int, inc: IncrementResult) -> None:
-        ps = inc.pressure * np.hypot(inc.slip[..., 0], inc.slip[..., 1])
-        self._up += ps
-        self.grid.deposit(self._lo, ps, inc)
-
-    def depths(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        return self.k * self._up, self.k * self._lo
+    def local_rate(self, inc: IncrementResult) -> NDArray[np.float64]:
+        return inc.pressure * np.hypot(inc.slip[..., 0], inc.slip[..., 1])
 
     def params(self) -> dict[str, Any]:
         return {"k_per_Pa": self.k}

@@ -46,7 +46,7 @@ from tribodem.dem.clumps import (
     quat_to_matrix,
     random_quaternions,
 )
-from tribodem.dem.surfaces import HeightMapSurface
+from tribodem.dem.surfaces import HeightMapSurface, bilinear_weights
 
 SHAPES = DEBRIS_SHAPES  # spherical, chunk, rubbing (seed figure 3.6; tribodem.dem.clumps)
 
@@ -116,30 +116,6 @@ def shape_function_coefficients(xn: NDArray[np.float64], yn: NDArray[np.float64]
     """a_1..a_4 of eqs 3.11-3.14 from the four nodes (X_k, Y_k, force_k) of one element."""
     a = np.stack([np.ones(4), xn, yn, xn * yn], axis=1)
     return np.linalg.solve(a, fn)
-
-
-def bilinear_weights(x: NDArray[np.float64], y: NDArray[np.float64], x0: float, y0: float,
-                     dx: float, dy: float, shape: tuple[int, int]
-                     ) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.float64]]:
-    """Node indices (i, j: [m, 4]) and weights ([m, 4]) of points in a regular grid.
-
-    For a value field this is eq 3.15 (the shape function through the element's four
-    nodal values evaluated at (x, y)); points outside the grid get zero weights.
-    """
-    u = (np.asarray(x, float) - x0) / dx
-    v = (np.asarray(y, float) - y0) / dy
-    nx, ny = shape
-    iu = np.floor(u).astype(np.int64)
-    iv = np.floor(v).astype(np.int64)
-    inside = (iu >= 0) & (iv >= 0) & (iu < nx - 1) & (iv < ny - 1)
-    iu = np.clip(iu, 0, nx - 2)
-    iv = np.clip(iv, 0, ny - 2)
-    fu, fv = u - iu, v - iv
-    w = np.stack([(1 - fu) * (1 - fv), fu * (1 - fv), (1 - fu) * fv, fu * fv], axis=1)
-    w *= inside[:, None]
-    ii = np.stack([iu, iu + 1, iu, iu + 1], axis=1)
-    jj = np.stack([iv, iv, iv + 1, iv + 1], axis=1)
-    return ii, jj, w
 
 
 def interpolate(field: NDArray[np.float64], x: NDArray[np.float64], y: NDArray[np.float64],
