@@ -144,6 +144,14 @@ def column_search(
     return depth.reshape(shape), saturated.reshape(shape)
 
 
+def _check_stress_grid(depth: float | None, nz: int) -> None:
+    """Validate the subsurface grid of a stress-based criterion (depth m or None, levels)."""
+    if depth is not None and not (math.isfinite(depth) and depth > 0):
+        raise ValueError(f"depth = {depth!r} is not allowed: must be > 0 m (or None)")
+    if int(nz) != nz or nz < 2:
+        raise ValueError(f"nz = {nz!r} is not allowed: must be an integer >= 2")
+
+
 class Criterion(ABC):
     """One material evolution criterion (plug-in). Subclasses register by ``name``."""
 
@@ -269,10 +277,7 @@ class ThresholdCriterion(Criterion):
                  samples: int = 8) -> None:
         if not (math.isfinite(threshold) and threshold > 0):
             raise ValueError(f"threshold = {threshold!r} is not allowed: must be > 0")
-        if depth is not None and not (math.isfinite(depth) and depth > 0):
-            raise ValueError(f"depth = {depth!r} is not allowed: must be > 0 m (or None)")
-        if int(nz) != nz or nz < 2:
-            raise ValueError(f"nz = {nz!r} is not allowed: must be an integer >= 2")
+        _check_stress_grid(depth, nz)
         if int(samples) != samples or samples < 1:
             raise ValueError(f"samples = {samples!r} is not allowed: must be an integer >= 1")
         self.threshold = float(threshold)
@@ -440,10 +445,7 @@ class DFDICriterion(Criterion):
     def __init__(self, eps0: float = 0.132, depth: float | None = None, nz: int = 33) -> None:
         if not (math.isfinite(eps0) and eps0 > 0):
             raise ValueError(f"eps0 = {eps0!r} is not allowed: must be > 0 (failure strain)")
-        if depth is not None and not (math.isfinite(depth) and depth > 0):
-            raise ValueError(f"depth = {depth!r} is not allowed: must be > 0 m (or None)")
-        if int(nz) != nz or nz < 2:
-            raise ValueError(f"nz = {nz!r} is not allowed: must be an integer >= 2")
+        _check_stress_grid(depth, nz)
         self.eps0 = float(eps0)
         self.depth = depth
         self.nz = int(nz)

@@ -30,6 +30,7 @@ dissipates is not counted as first-body wear.
 from __future__ import annotations
 
 import math
+import time
 from dataclasses import asdict, dataclass, field
 from typing import Any
 
@@ -359,8 +360,6 @@ def run_de_phase(field: DebrisField, lower: NDArray[np.float64], gap: NDArray[np
     *undeformed* curved body would put the whole debris load on the few particles at its
     apex; the seed replaced its worn upper body by a flat profile for the DE phase, 5.4.)
     """
-    import time
-
     s = field.settings
     t0 = time.perf_counter()
     dx = float(coords[1] - coords[0])
