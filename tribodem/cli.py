@@ -13,6 +13,8 @@ import sys
 import typer
 
 from tribodem import __version__
+from typer import TyperException
+
 from tribodem.io.config import ConfigError
 
 app = typer.Typer(
@@ -57,28 +59,39 @@ _register()
 
 
 def main() -> None:
-    """Entry point: run the app, mapping known errors to messages and exit codes."""
-    from tribodem.dem.errors import SimulationUnstable
+    """Entry point: run the app, mapping every outcome to a message and an exit code.
+
+    0 done; 2 usage or validation error (typer's own short message, or field, value and what
+    is allowed); 3 the run stopped early (instability, contact outgrew the window): outputs
+    kept; 130 Ctrl-C, after saying where the outputs and the last checkpoint are. None of
+    these prints a traceback.
+    """
+    from tribodem.io import runs
 
     try:
         app(standalone_mode=False)
     except ConfigError as err:
         typer.echo(f"error: {err}", err=True)
         sys.exit(2)
-    except SimulationUnstable as err:
+    except runs.RunStopped as err:
         typer.echo(f"run stopped: {err}", err=True)
+        where = runs.where()
+        if where:
+            typer.echo(where, err=True)
         sys.exit(3)
+    except (KeyboardInterrupt, typer.Abort):
+        where = runs.where()
+        typer.echo("\ninterrupted (Ctrl-C)" + (f": {where}" if where else ""), err=True)
+        sys.exit(130)
     except typer.Exit as e:
         sys.exit(e.exit_code)
-    except typer.Abort:
-        sys.exit(1)
-    except Exception as err:  # click usage errors
-        import click
-
-        if isinstance(err, click.exceptions.ClickException):
-            err.show()
-            sys.exit(2)
-        raise
+    except TyperException as err:  # typer/click usage errors: its own short message
+        show = getattr(err, "show", None)
+        if callable(show):
+            show()
+        else:
+            typer.echo(f"error: {err}", err=True)
+        sys.exit(getattr(err, "exit_code", 2) or 2)
 
 
 if __name__ == "__main__":

@@ -1,9 +1,10 @@
 """Errors the engine raises; each message says what happened and why."""
 
 from tribodem.io.config import ConfigError
+from tribodem.io.runs import RunStopped
 
 
-class SimulationUnstable(RuntimeError):
+class SimulationUnstable(RunStopped):
     """The run went numerically unstable (NaN, runaway overlap); outputs so far are kept."""
 
 
