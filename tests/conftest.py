@@ -21,3 +21,26 @@ def two_spheres(v0: float, cor: float, r: float = 0.005, friction: float = 0.0) 
 @pytest.fixture
 def rng() -> np.random.Generator:
     return np.random.default_rng(1234)
+
+
+def tribodem_exe() -> str:
+    """The installed ``tribodem`` console script (beside this interpreter, else on PATH)."""
+    import shutil
+    import sys
+    from pathlib import Path
+
+    exe = Path(sys.executable).with_name("tribodem")
+    if exe.is_file():
+        return str(exe)
+    found = shutil.which("tribodem")
+    if found is None:
+        pytest.fail("the tribodem command is not installed (pip install -e .)")
+    return found
+
+
+def run_tribodem(*args: str, timeout: float = 600, **kw):  # noqa: ANN201
+    """Run the installed ``tribodem`` command as a real subprocess (text output captured)."""
+    import subprocess
+
+    return subprocess.run([tribodem_exe(), *args], capture_output=True, text=True,
+                          timeout=timeout, **kw)
