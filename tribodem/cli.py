@@ -11,10 +11,9 @@ from __future__ import annotations
 import sys
 
 import typer
-
-from tribodem import __version__
 from typer import TyperException
 
+from tribodem import __version__
 from tribodem.io.config import ConfigError
 
 app = typer.Typer(

@@ -7,7 +7,6 @@ import time
 from pathlib import Path
 from typing import Literal
 
-import numpy as np
 import typer
 from pydantic import BaseModel, ConfigDict, Field
 
@@ -65,6 +64,32 @@ def _build(cfg: DemRunConfig):  # noqa: ANN202 - returns (Simulation, BenchCase)
     return simulation_from_case(case), case
 
 
+def _resolve(config: Path | None, quick: bool, out: Path, resume: bool) -> DemRunConfig:
+    """Defaults <- config file <- ``--quick`` <- (resume) the run's own config.toml.
+
+    With ``--resume`` and no ``--config`` the run's own resolved config is used; a config
+    that differs from it in anything but ``run.steps`` / ``run.threads`` is refused.
+    """
+    own = out / "config.toml"
+    if resume and config is None and own.is_file():
+        config = own
+    data = load_toml(config) if config else {}
+    if quick:
+        data = merge(data, QUICK) if config else merge(QUICK, data)
+    cfg = validate(DemRunConfig, data, source=str(config) if config else "dem run")
+    if resume and own.is_file() and config != own:
+        old = validate(DemRunConfig, load_toml(own), source=str(own)).model_dump()
+        new = cfg.model_dump()
+        for sec in ("case", "output"):
+            for k, v in new[sec].items():
+                if old[sec][k] != v:
+                    raise ConfigError(
+                        f"--resume: {sec}.{k} = {v!r} differs from the checkpointed run's "
+                        f"{old[sec][k]!r} ('{own}'); allowed: the same value (only "
+                        "run.steps and run.threads may change)")
+    return cfg
+
+
 @dem_app.command("run")
 def dem_run(
     out: Path = typer.Option(..., "--out", help="Output directory."),
@@ -77,37 +102,54 @@ def dem_run(
     import numba
 
     from tribodem.dem.recorders import ScalarRecorder, VTKRecorder, default_probes
+    from tribodem.dem.state import BYTES_PER_PARTICLE
+    from tribodem.io import runs
 
-    data = load_toml(config) if config else {}
-    if quick:
-        data = merge(QUICK, data)
-    cfg = validate(DemRunConfig, data, source=str(config) if config else "dem run")
-    if cfg.run.threads:
-        numba.set_num_threads(min(cfg.run.threads, numba.config.NUMBA_NUM_THREADS))
     ck = out / "checkpoint.npz"
-    if resume and not ck.exists():
-        raise ConfigError(f"--resume: no checkpoint at '{ck}'")
+    runs.check_out_dir(out, "--out", resume=resume, need=("checkpoint.npz",) if resume else ())
+    cfg = _resolve(config, quick, out, resume)
+    runs.check_memory(cfg.case.particles, BYTES_PER_PARTICLE, "case.particles")
+    threads = runs.check_threads(cfg.run.threads, "run.threads")
+    numba.set_num_threads(threads)
+    sim, case = _build(cfg)
+    if resume:  # check the checkpoint before touching any output
+        try:
+            sim.load_checkpoint(ck)
+        except Exception as err:  # noqa: BLE001 - any unreadable or foreign checkpoint
+            raise ConfigError(f"--resume: checkpoint '{ck}' cannot be used: {err}") from None
+        if sim.step_count > cfg.run.steps:
+            raise ConfigError(f"run.steps = {cfg.run.steps}: the checkpoint is already at step "
+                              f"{sim.step_count}; allowed: >= {sim.step_count}")
+    runs.announce(out, ck if cfg.output.checkpoint_every else None,
+                  resume_hint="add --resume to the same command")
     out.mkdir(parents=True, exist_ok=True)
     write_text(out / "config.toml", dump_toml(cfg.model_dump()))
-    sim, case = _build(cfg)
     scalars = ScalarRecorder(out / "timeseries.csv", default_probes(sim))
+    vtk = VTKRecorder(out / "vtk") if cfg.output.vtk_every else None
     if resume:
-        sim.load_checkpoint(ck)
-        old = np.genfromtxt(out / "timeseries.csv", delimiter=",", names=True, ndmin=1)
-        scalars.rows = [list(r) for r in old if r["step"] <= sim.step_count]
+        scalars.resume(sim.step_count)
+        if vtk is not None:
+            vtk.resume(sim.step_count)
+        runs.checkpoint_written(ck)
     sim.add_recorder(scalars, cfg.output.scalars_every)
-    if cfg.output.vtk_every:
-        sim.add_recorder(VTKRecorder(out / "vtk"), cfg.output.vtk_every)
+    if vtk is not None:
+        sim.add_recorder(vtk, cfg.output.vtk_every)
     t0 = time.perf_counter()
-    remaining = cfg.run.steps - sim.step_count
-    every = cfg.output.checkpoint_every or remaining
-    while remaining > 0:
-        k = min(every, remaining)
-        sim.run(k, progress=progress and remaining > 2000)
-        remaining -= k
-        if cfg.output.checkpoint_every:
-            sim.save_checkpoint(ck)
+    every = cfg.output.checkpoint_every or cfg.run.steps
+    chunk = max(1, min(every, 1000))
+    with runs.progress(cfg.run.steps, "step", "dem run", enabled=progress,
+                       initial=sim.step_count) as bar:
+        while sim.step_count < cfg.run.steps:
+            k = min(chunk, cfg.run.steps - sim.step_count, every - sim.step_count % every)
+            sim.step(k)
+            bar.update(k)
+            if cfg.output.checkpoint_every and sim.step_count % every == 0:
+                scalars.flush()  # the CSV is never behind the checkpoint
+                sim.save_checkpoint(ck)
+                runs.checkpoint_written(ck)
     sim.close_recorders()
+    if cfg.output.checkpoint_every and sim.step_count % every:  # the end, to extend later
+        sim.save_checkpoint(ck)
     wall = time.perf_counter() - t0
     summary = {
         "case": case.name, "particles": sim.p.n, "steps": sim.step_count,
@@ -126,9 +168,9 @@ def dem_run(
 def bench_dem(
     case: str = typer.Option("settle3d", "--case", help="settle3d (Hertz) or compress2d."),
     quick: bool = typer.Option(False, "--quick", help="2,000 particles, 200 steps."),
-    particles: int | None = typer.Option(None, "--particles", min=10),
-    steps: int | None = typer.Option(None, "--steps", min=1),
-    threads: int | None = typer.Option(None, "--threads", min=1),
+    particles: int | None = typer.Option(None, "--particles", min=10, max=100_000_000),
+    steps: int | None = typer.Option(None, "--steps", min=1, max=10**9),
+    threads: int | None = typer.Option(None, "--threads", help="1..cores (default: all)."),
     as_json: bool = typer.Option(False, "--json", help="Print one JSON object."),
 ) -> None:
     """Particle-steps per second of the engine on a benchmark case."""
@@ -136,9 +178,16 @@ def bench_dem(
 
     if case not in CASES:
         raise ConfigError(f"bench dem: --case = {case!r}: must be one of {sorted(CASES)}")
+    from tribodem.dem.state import BYTES_PER_PARTICLE
+    from tribodem.io import runs
+
     if quick:
         particles = particles or 2000
         steps = steps or 200
+    if threads is not None:
+        runs.check_threads(threads, "--threads", zero_means_all=False)
+    if particles is not None:
+        runs.check_memory(particles, BYTES_PER_PARTICLE, "--particles")
     res = run_case(case, n=particles, steps=steps, threads=threads)
     if as_json:
         typer.echo(json.dumps(res))

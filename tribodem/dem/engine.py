@@ -149,6 +149,7 @@ class Simulation:
         self.tpair_j = np.zeros((m, 3))
         self.pinfo = np.zeros((m, 4))
         self.pinfo[:, 0] = 1.0  # unknown yet: the first evaluation clears what is apart
+        self._evaluated = False  # pinfo holds no evaluation yet (see _active)
 
     def add_interaction(self, inter: Interaction) -> None:
         """Add an extra force contribution, evaluated every step after contacts.
@@ -211,6 +212,7 @@ class Simulation:
             self.nl.pair_j, self.hist, self.pairtab, self.elin, self.box.length,
             self.box.periodic, p.dim, p.thickness, self.dt, self.fpair, self.tpair_i,
             self.tpair_j, self.pinfo)
+        self._evaluated = True
 
     def _advance(self) -> None:
         p = self.p
@@ -348,16 +350,33 @@ class Simulation:
         """Potential energy in the gravity field (J), zero at the origin."""
         return float(-(self.p.mass * (self.p.pos @ self.gravity)).sum())
 
+    def _overlaps(self) -> np.ndarray:
+        """Overlap of every listed pair, m (> 0 in contact). Before the first force evaluation
+        (the sample at step 0) ``pinfo`` holds placeholders, so it comes from geometry."""
+        if self._evaluated:
+            return self.pinfo[:, 0]
+        p, i, j = self.p, self.nl.pair_i, self.nl.pair_j
+        d = p.pos[j] - p.pos[i]
+        per = np.asarray(self.box.periodic, dtype=bool)
+        if per.any():
+            L = np.asarray(self.box.length, dtype=float)
+            d[:, per] -= L[per] * np.round(d[:, per] / L[per])
+        return p.radius[i] + p.radius[j] - np.linalg.norm(d, axis=1)
+
+    def _active(self) -> np.ndarray:
+        return self._overlaps() > 0
+
     def n_contacts(self) -> int:
-        """Particle-particle contacts carrying force."""
-        return int(np.count_nonzero(self.pinfo[:, 0] > 0))
+        """Particle-particle contacts carrying force (touching, before the first step)."""
+        return int(np.count_nonzero(self._active()))
 
     def contacts(self) -> dict[str, np.ndarray]:
         """Active particle-particle contacts: i, j, overlap (m), normal force (N, + = push),
         force vector on j (N)."""
-        act = self.pinfo[:, 0] > 0
+        ov = self._overlaps()
+        act = ov > 0
         return {"i": self.nl.pair_i[act], "j": self.nl.pair_j[act],
-                "overlap": self.pinfo[act, 0], "normal_force": self.pinfo[act, 1],
+                "overlap": ov[act], "normal_force": self.pinfo[act, 1],
                 "force": self.fpair[act]}
 
     # ------------------------------------------------------------------ checkpoints
@@ -422,5 +441,6 @@ class Simulation:
                     pre = f"x{x_id}_"
                     inter.set_state({k[len(pre):]: z[k] for k in z.files if k.startswith(pre)})
             self.step_count = int(meta["step"])
+            self._evaluated = self.step_count > 0
             self.time = float(z["time_exact"][0])
             self.dt = float(meta["dt"])

@@ -66,6 +66,29 @@ class ScalarRecorder:
         """Final flush."""
         self.flush()
 
+    def resume(self, step: int) -> None:
+        """Take back the rows of an earlier run up to ``step`` (from the CSV on disk), with
+        their exact values and types, so the rewritten file is byte-identical."""
+        import csv
+
+        if not self.path.is_file():
+            return
+        with self.path.open(newline="") as fh:
+            rows = list(csv.reader(fh))
+        if not rows:
+            return
+        if rows[0] != list(self.probes):
+            raise ValueError(f"'{self.path}': its columns are not this run's probes")
+        k = rows[0].index("step")
+        self.rows = [[_number(x) for x in r] for r in rows[1:] if int(r[k]) <= step]
+
+
+def _number(text: str) -> float:
+    try:
+        return int(text)
+    except ValueError:
+        return float(text)
+
 
 class VTKRecorder:
     """Particle snapshots (``particles_<step>.vtu``) and force chains (``chains_<step>.vtu``).
@@ -103,3 +126,24 @@ class VTKRecorder:
 
     def close(self) -> None:
         """Nothing buffered: every snapshot is complete on disk when written."""
+
+    def resume(self, step: int) -> None:
+        """Take back the snapshots of an earlier run up to ``step`` (from the ``.pvd``
+        indexes on disk), so the indexes keep every snapshot across a resume."""
+        self.entries = _pvd_entries(self.dir / "particles.pvd", step)
+        if self.chains:
+            self.chain_entries = _pvd_entries(self.dir / "chains.pvd", step)
+
+
+def _pvd_entries(path: Path, step: int) -> list[tuple[float, str]]:
+    """(time, file) rows of a ``.pvd`` written by ``write_pvd`` whose file's step <= ``step``."""
+    import re
+
+    if not path.is_file():
+        return []
+    out = []
+    for t, f in re.findall(r'timestep="([^"]+)"[^>]*file="([^"]+)"', path.read_text()):
+        m = re.search(r"_(\d+)\.vtu$", f)
+        if m and int(m.group(1)) <= step and (path.parent / f).is_file():
+            out.append((float(t), f))
+    return out

@@ -19,6 +19,12 @@ FIX_2D = FIX_Z | FIX_RX | FIX_RY
 FIX_CLUMP = 64
 
 
+#: Memory per particle of a run, bytes, for refusing runs that cannot fit: measured
+#: 1.16 kB per sphere (settle3d, 200k spheres, ~3 neighbour pairs each, peak RSS) and
+#: doubled for dense packings (~7 pairs each) and the output buffers.
+BYTES_PER_PARTICLE = 2500.0
+
+
 @dataclass
 class ParticleState:
     """Particles of one simulation (SI units).

@@ -47,6 +47,8 @@ def validate(model: type[M], data: dict[str, Any], source: str = "config") -> M:
 def load_toml(path: str | Path) -> dict[str, Any]:
     """Read a TOML file, turning syntax errors into ``ConfigError``."""
     p = Path(path)
+    if p.is_dir():
+        raise ConfigError(f"config file '{p}' is a folder; allowed: a TOML file")
     if not p.is_file():
         raise ConfigError(f"config file '{p}' does not exist")
     try:
@@ -54,6 +56,8 @@ def load_toml(path: str | Path) -> dict[str, Any]:
             return tomllib.load(fh)
     except tomllib.TOMLDecodeError as err:
         raise ConfigError(f"config file '{p}' is not valid TOML: {err}") from None
+    except (OSError, UnicodeDecodeError) as err:
+        raise ConfigError(f"config file '{p}' cannot be read: {err}") from None
 
 
 def load_config(model: type[M], path: str | Path) -> M:
@@ -73,7 +77,11 @@ def merge(base: dict[str, Any], override: dict[str, Any]) -> dict[str, Any]:
 
 
 def dump_toml(data: dict[str, Any]) -> str:
-    """Minimal TOML writer for resolved configs (tables of scalars/lists)."""
+    """Minimal TOML writer for resolved configs (tables of scalars/lists).
+
+    A key whose value is None is left out (TOML has no null): on reload the field takes its
+    default, which is None wherever a config model allows None, so the file round-trips.
+    """
     def fmt(v: Any) -> str:
         if isinstance(v, bool):
             return "true" if v else "false"
@@ -81,17 +89,15 @@ def dump_toml(data: dict[str, Any]) -> str:
             return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
         if isinstance(v, (list, tuple)):
             return "[" + ", ".join(fmt(x) for x in v) + "]"
-        if v is None:
-            return '"none"'
         return repr(v)
 
-    scalars = [(k, v) for k, v in data.items() if not isinstance(v, dict)]
-    tables = [(k, v) for k, v in data.items() if isinstance(v, dict)]
-    out = [f"{k} = {fmt(v)}" for k, v in scalars]
-    for name, table in tables:
-        out.append(f"\n[{name}]")
-        out += [f"{k} = {fmt(v)}" for k, v in table.items() if not isinstance(v, dict)]
-        for sub, st in ((k, v) for k, v in table.items() if isinstance(v, dict)):
-            out.append(f"\n[{name}.{sub}]")
-            out += [f"{k} = {fmt(v)}" for k, v in st.items()]
-    return "\n".join(out) + "\n"
+    def table(prefix: str, d: dict[str, Any]) -> list[str]:
+        lines = [f"{k} = {fmt(v)}" for k, v in d.items()
+                 if v is not None and not isinstance(v, dict)]
+        for k, v in d.items():
+            if isinstance(v, dict):
+                name = f"{prefix}.{k}" if prefix else k
+                lines += [f"\n[{name}]", *table(name, v)]
+        return lines
+
+    return "\n".join(table("", data)) + "\n"

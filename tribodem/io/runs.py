@@ -77,8 +77,8 @@ def check_out_dir(out: str | Path, field: str = "--out", resume: bool = False,
                   need: tuple[str, ...] = ()) -> Path:
     """Check an output folder before any work; ``ConfigError`` names ``field`` and the value.
 
-    It must be a folder (or not exist yet) in a writable place. With ``resume``, it must
-    exist and hold the files named in ``need``.
+    It must be a folder (or not exist yet) in a writable place; nothing is created here.
+    With ``resume``, it must exist and hold the files named in ``need``.
     """
     p = Path(out)
     if p.exists() and not p.is_dir():
@@ -101,13 +101,14 @@ def check_out_dir(out: str | Path, field: str = "--out", resume: bool = False,
     if not os.access(parent, os.W_OK | os.X_OK):
         raise ConfigError(f"{field} = '{p}': '{parent}' is not writable; allowed: a folder "
                           "in a writable place")
-    try:
-        p.mkdir(parents=True, exist_ok=True)
-        fd, probe = tempfile.mkstemp(dir=p, prefix=".tribodem-write-test-")
-        os.close(fd)
-        os.unlink(probe)
-    except OSError as err:
-        raise ConfigError(f"{field} = '{p}': cannot write there ({err.strerror})") from None
+    if p.is_dir():  # an existing folder: try a write (permissions, read-only mounts)
+        try:
+            fd, probe = tempfile.mkstemp(dir=p, prefix=".tribodem-write-test-")
+            os.close(fd)
+            os.unlink(probe)
+        except OSError as err:
+            raise ConfigError(f"{field} = '{p}': cannot write there ({err.strerror})"
+                              ) from None
     return p
 
 
@@ -148,3 +149,43 @@ class _NoBar:
 
     def set_postfix_str(self, s: str) -> None:
         """Nothing to show."""
+
+
+def available_memory() -> int:
+    """Memory this machine can give a new run, bytes (MemAvailable; total RAM as fallback)."""
+    try:
+        with open("/proc/meminfo") as fh:
+            for line in fh:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except OSError:
+        pass
+    return int(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
+
+
+def check_memory(count: int, bytes_each: float, field: str, fraction: float = 0.8) -> None:
+    """Refuse (``ConfigError``) ``count`` items of ``bytes_each`` when that is above
+    ``fraction`` of the memory available, naming the field, the value and the largest count
+    that fits."""
+    have = available_memory()
+    need = count * bytes_each
+    if need > fraction * have:
+        fits = int(fraction * have / bytes_each)
+        raise ConfigError(
+            f"{field} = {count!r}: needs about {need / 2**30:.3g} GiB (~{bytes_each:.0f} B "
+            f"each), but this machine has {have / 2**30:.1f} GiB available; allowed: at most "
+            f"about {fits:,}")
+
+
+def check_threads(threads: int, field: str, zero_means_all: bool = True) -> int:
+    """Check a thread count against the cores numba may use; returns the count to set
+    (0 -> all when ``zero_means_all``). ``ConfigError`` names the field and the range."""
+    import numba
+
+    most = int(numba.config.NUMBA_NUM_THREADS)
+    low = 0 if zero_means_all else 1
+    if not low <= threads <= most:
+        extra = " (0 = all)" if zero_means_all else ""
+        raise ConfigError(f"{field} = {threads!r}: allowed: {low}..{most}{extra} "
+                          f"(this machine has {most} core(s) for numba)")
+    return threads or most
