@@ -146,7 +146,9 @@ def test_quick_coupled_cli_run(tmp_path) -> None:
 
     from typer.testing import CliRunner
 
-    from tribodem.cli import app
+    from tribodem.cli import full_app
+
+    app = full_app()
 
     out = tmp_path / "fd"
     res = CliRunner().invoke(app, ["fretting", "run", "--quick", "--cycles", "3",

@@ -39,22 +39,43 @@ def _root(
     """tribodem: wear at contact interfaces with particles."""
 
 
-def _register() -> None:
-    from tribodem.braking.cli import braking_app
-    from tribodem.cyclejump_cli import jump_app
-    from tribodem.dem.cli import bench_app, dem_app
-    from tribodem.fretting.cli import fretting_app
-    from tribodem.materials.cli import calibrate
-
-    app.add_typer(dem_app, name="dem")
-    app.add_typer(bench_app, name="bench")
-    app.add_typer(jump_app, name="jump")
-    app.add_typer(fretting_app, name="fretting")
-    app.command("calibrate")(calibrate)
-    app.add_typer(braking_app, name="braking")
+#: Sub-commands: name -> (module, attribute, a typer group or a single command).
+COMMANDS: dict[str, tuple[str, str, bool]] = {
+    "calibrate": ("tribodem.materials.cli", "calibrate", False),
+    "dem": ("tribodem.dem.cli", "dem_app", True),
+    "bench": ("tribodem.dem.cli", "bench_app", True),
+    "jump": ("tribodem.cyclejump_cli", "jump_app", True),
+    "fretting": ("tribodem.fretting.cli", "fretting_app", True),
+    "braking": ("tribodem.braking.cli", "braking_app", True),
+}
 
 
-_register()
+_registered: set[str] = set()
+
+
+def full_app() -> typer.Typer:
+    """The app with every sub-command registered (for in-process use, e.g. tests)."""
+    _register()
+    return app
+
+
+def _register(argv: list[str] | None = None) -> None:
+    """Add the sub-commands. Given the command line, only the one it names is imported (each
+    room's imports cost up to a second); otherwise (help, a typo) all of them."""
+    import importlib
+
+    first = next((a for a in (argv or []) if not a.startswith("-")), None)
+    names = [first] if first in COMMANDS else list(COMMANDS)
+    for name in names:
+        if name in _registered:
+            continue
+        _registered.add(name)
+        module, attr, group = COMMANDS[name]
+        obj = getattr(importlib.import_module(module), attr)
+        if group:
+            app.add_typer(obj, name=name)
+        else:
+            app.command(name)(obj)
 
 
 def main() -> None:
@@ -68,6 +89,7 @@ def main() -> None:
     from tribodem.io import runs
 
     try:
+        _register(sys.argv[1:])
         app(standalone_mode=False)
     except ConfigError as err:
         typer.echo(f"error: {err}", err=True)

@@ -38,12 +38,14 @@ def read_increments_csv(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
     increments must be finite numbers.
     """
     p = Path(path)
+    if p.is_dir():
+        raise ConfigError(f"--input = '{p}': is a folder; allowed: a CSV file")
     if not p.is_file():
-        raise ConfigError(f"input file '{p}' does not exist")
+        raise ConfigError(f"--input = '{p}': file does not exist")
     try:
         with p.open(newline="") as fh:
             rows = list(csv.reader(fh))
-    except (UnicodeDecodeError, csv.Error) as err:
+    except (UnicodeDecodeError, csv.Error, OSError) as err:
         raise ConfigError(f"input file '{p}' is not a readable CSV: {err}") from None
     rows = [r for r in rows if r and any(x.strip() for x in r)]
     if not rows:
@@ -194,6 +196,10 @@ def replay_cmd(
         strat = make_strategy(strategy, **params)
     except ValueError as err:
         raise ConfigError(f"strategy '{strategy}' parameters: {err}") from None
+    if plot is not None:
+        from tribodem.io.runs import check_out_file
+
+        check_out_file(plot, "--plot")
     cycles, incs = read_increments_csv(input)
     need = strat.foundation + 1
     if len(cycles) < need:

@@ -44,20 +44,20 @@ def validate(model: type[M], data: dict[str, Any], source: str = "config") -> M:
         raise ConfigError(format_validation_error(err, source)) from None
 
 
-def load_toml(path: str | Path) -> dict[str, Any]:
-    """Read a TOML file, turning syntax errors into ``ConfigError``."""
+def load_toml(path: str | Path, field: str = "--config") -> dict[str, Any]:
+    """Read a TOML file, turning every problem into ``ConfigError`` naming ``field``."""
     p = Path(path)
     if p.is_dir():
-        raise ConfigError(f"config file '{p}' is a folder; allowed: a TOML file")
+        raise ConfigError(f"{field} = '{p}': is a folder; allowed: a TOML file")
     if not p.is_file():
-        raise ConfigError(f"config file '{p}' does not exist")
+        raise ConfigError(f"{field} = '{p}': config file does not exist")
     try:
         with p.open("rb") as fh:
             return tomllib.load(fh)
     except tomllib.TOMLDecodeError as err:
-        raise ConfigError(f"config file '{p}' is not valid TOML: {err}") from None
+        raise ConfigError(f"{field} = '{p}': not valid TOML: {err}") from None
     except (OSError, UnicodeDecodeError) as err:
-        raise ConfigError(f"config file '{p}' cannot be read: {err}") from None
+        raise ConfigError(f"{field} = '{p}': cannot be read: {err}") from None
 
 
 def load_config(model: type[M], path: str | Path) -> M:

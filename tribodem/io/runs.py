@@ -113,16 +113,12 @@ def check_out_dir(out: str | Path, field: str = "--out", resume: bool = False,
 
 
 def check_out_file(path: str | Path, field: str) -> Path:
-    """Check a file to be written (e.g. ``--plot``): its folder exists and is writable."""
+    """Check a file to be written (e.g. ``--plot``) before any work: not a folder, and its
+    folder exists or can be made in a writable place (``ConfigError`` otherwise)."""
     p = Path(path)
     if p.is_dir():
         raise ConfigError(f"{field} = '{p}': is a folder; allowed: a file path")
-    parent = p.parent if str(p.parent) else Path(".")
-    if not parent.is_dir():
-        raise ConfigError(f"{field} = '{p}': folder '{parent}' does not exist; allowed: a "
-                          "file in an existing folder")
-    if not os.access(parent, os.W_OK | os.X_OK):
-        raise ConfigError(f"{field} = '{p}': folder '{parent}' is not writable")
+    check_out_dir(p.parent if str(p.parent) else Path("."), field)
     return p
 
 
