@@ -20,7 +20,7 @@ from tribodem.dem.errors import SimulationUnstable, TimeStepError
 from tribodem.dem.integrate import BLOCK, advance, critical_step
 from tribodem.dem.space import Box
 from tribodem.dem.state import ParticleState
-from tribodem.dem.walls import PlaneWall, wall_arrays
+from tribodem.dem.walls import PlaneWall, near_walls, wall_arrays, wall_forces
 from tribodem.io.results import write_npz
 
 CHECKPOINT_VERSION = 1
@@ -96,6 +96,9 @@ class Simulation:
         self.wall_info = np.zeros((len(self.walls), n, 4))
         nblocks = (n + BLOCK - 1) // BLOCK
         self._wsum = np.zeros((nblocks, len(self.walls), 5))
+        self._wforce = np.zeros((n, 3))
+        self._wtorque = np.zeros((n, 3))
+        self._build_wall_list()
         self.drift = np.zeros(nblocks)
         self.dt_critical, self.dt_limit_by = critical_step(
             self.p.density, self.p.radius, self.p.mass, self.p.inertia, self.p.mat,
@@ -191,8 +194,32 @@ class Simulation:
         self.recorders.append((int(every), recorder))
 
     # ------------------------------------------------------------------ stepping
+    def _build_wall_list(self, at: np.ndarray | None = None) -> None:
+        """Near-wall candidates (gap below the skin) and each wall's position at the build,
+        from the neighbour list's reference state (``at``: the walls' points then; default:
+        now), so a checkpoint restores exactly the list of the run it came from."""
+        wp, wn, _, _ = wall_arrays(self.walls)
+        if at is not None:
+            wp = np.asarray(at, dtype=np.float64).reshape(wp.shape)
+        self._wstart, self._wid = near_walls(self.nl.ref_pos, self.nl.ref_radius, wp, wn,
+                                             self.skin)
+        self._wall_ref = (wp, wn)
+        self._wforce[:] = 0.0
+        self._wtorque[:] = 0.0
+
+    def _walls_drifted(self) -> bool:
+        """A wall moved more than half the skin along its normal (or turned) since the build."""
+        if not self.walls:
+            return False
+        wp0, wn0 = self._wall_ref
+        for w_id, w in enumerate(self.walls):
+            if not np.array_equal(w.normal, wn0[w_id]) or \
+                    abs(float((w.point - wp0[w_id]) @ w.normal)) > 0.5 * self.skin:
+                return True
+        return False
+
     def _maybe_rebuild(self) -> None:
-        if self.drift.max(initial=0.0) <= 0.5 * self.skin:
+        if self.drift.max(initial=0.0) <= 0.5 * self.skin and not self._walls_drifted():
             return
         old, old_hist = self.nl, self.hist
         self.nl = neighbors.build(self.p.pos, self.p.radius, self.skin, self.box.lo,
@@ -204,6 +231,7 @@ class Simulation:
                                                   self.nl.start, self.nl.pair_j, self.hist)
         self._alloc_pairs()
         self.drift[:] = 0.0
+        self._build_wall_list()
 
     def _pair_forces(self) -> None:
         p = self.p
@@ -214,24 +242,34 @@ class Simulation:
             self.tpair_j, self.pinfo)
         self._evaluated = True
 
-    def _advance(self) -> None:
+    def _wall_pass(self) -> None:
+        """Plane-wall contacts of the near-wall candidates (``walls.wall_forces``); sets each
+        wall's measured force, contact count and stiffness (for the servo)."""
+        if not self.walls:
+            return
         p = self.p
         wp, wn, wv, wm = wall_arrays(self.walls)
+        wall_forces.pick(p.n)(
+            p.pos, p.vel, p.omega, p.radius, p.mass, p.inertia, p.mat, self._wstart,
+            self._wid, wp, wn, wv, wm, self.wall_hist, self.wall_info, self._wsum,
+            self.pairtab, self.elin, p.dim, p.thickness, self.dt, BLOCK, self._wforce,
+            self._wtorque)
+        tot = self._wsum.sum(axis=0)
+        for w_id, w in enumerate(self.walls):
+            w.force = tot[w_id, :3].copy()
+            w.normal_force = -float(w.force @ w.normal)
+            w.contacts = int(tot[w_id, 3])
+            w.stiffness = float(tot[w_id, 4])
+
+    def _advance(self) -> None:
+        p = self.p
         advance.pick(p.n)(
-            p.pos, p.vel, p.omega, p.radius, p.mass, p.inertia, p.mat, p.fixed, self.nl.start,
-            self.nl.rev_start, self.nl.rev_pair, self.fpair, self.tpair_i, self.tpair_j, wp,
-            wn, wv, wm, self.wall_hist, self.wall_info, self._wsum, self.pairtab, self.elin,
-            p.dim, p.thickness, self.dt, self.gravity, self.viscous_damping,
+            p.pos, p.vel, p.omega, p.radius, p.mass, p.inertia, p.fixed, self.nl.start,
+            self.nl.rev_start, self.nl.rev_pair, self.fpair, self.tpair_i, self.tpair_j,
+            self._wforce, self._wtorque, self.dt, self.gravity, self.viscous_damping,
             self.local_damping, self.ext_force, self.ext_torque, self.force, self.torque,
             self.nl.ref_pos, self.nl.ref_radius, self.box.lo, self.box.length,
             self.box.periodic, self.drift)
-        if self.walls:
-            tot = self._wsum.sum(axis=0)
-            for w_id, w in enumerate(self.walls):
-                w.force = tot[w_id, :3].copy()
-                w.normal_force = -float(w.force @ w.normal)
-                w.contacts = int(tot[w_id, 3])
-                w.stiffness = float(tot[w_id, 4])
 
     def step(self, n: int = 1) -> None:
         """Advance ``n`` steps. Raises ``SimulationUnstable`` (recorders flushed) on blow-up.
@@ -255,6 +293,7 @@ class Simulation:
                 if self.track_energy:
                     p = self.p
                     self._at_force_eval = (p.pos.copy(), p.vel.copy(), p.omega.copy())
+                self._wall_pass()
                 self._advance()
                 for inter in self._after:
                     inter.after_advance(self)
@@ -390,6 +429,7 @@ class Simulation:
             "hist": self.hist, "wall_hist": self.wall_hist, "wall_info": self.wall_info,
             "pinfo": self.pinfo, "force": self.force, "torque": self.torque,
             "drift": self.drift, "ext_force": self.ext_force, "ext_torque": self.ext_torque,
+            "wall_ref_point": self._wall_ref[0] if self.walls else np.zeros((0, 3)),
         })
         for w_id, w in enumerate(self.walls):
             for k, v in w.state().items():
@@ -433,6 +473,8 @@ class Simulation:
             self.drift = z["drift"].copy()
             self.ext_force = z["ext_force"].copy()
             self.ext_torque = z["ext_torque"].copy()
+            self._build_wall_list(at=z["wall_ref_point"] if "wall_ref_point" in z.files
+                                  else None)
             for w_id, w in enumerate(self.walls):
                 w.set_state({k: z[f"w{w_id}_{k}"] for k in ("point", "velocity", "force",
                                                             "scalars")})

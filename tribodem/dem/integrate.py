@@ -18,7 +18,6 @@ from numba import njit, prange
 from tribodem.dem.contact import LINEAR, P_KRATIO, P_LAW
 from tribodem.dem.jit import kernel
 from tribodem.dem.space import min_image
-from tribodem.dem.walls import wall_contact
 
 BLOCK = 256  # particles per block: fixed, so block sums do not depend on the thread count
 
@@ -49,28 +48,23 @@ def _update(pos, vel, omega, i, f, t, m, inertia, fixed, a, b, local, dt):
 
 
 @kernel(chunk=2)
-def advance(pos, vel, omega, radius, mass, inertia, mat, fixed, start, rev_start, rev_pair,
-            fpair, tpair_i, tpair_j, wpoint, wnormal, wvel, wmat, whist, winfo, wsum, pairtab,
-            elin, dim, thickness, dt, gravity, viscous, local, ext_force, ext_torque,
-            force, torque, ref_pos, ref_radius, lo, length, periodic, drift):
-    """One step for every particle: gather pair forces, wall contacts, external forces,
-    gravity, then the central-difference update with damping and the periodic wrap.
+def advance(pos, vel, omega, radius, mass, inertia, fixed, start, rev_start, rev_pair,
+            fpair, tpair_i, tpair_j, wforce, wtorque, dt, gravity, viscous, local, ext_force,
+            ext_torque, force, torque, ref_pos, ref_radius, lo, length, periodic, drift):
+    """One step for every particle: gather pair forces, the wall pass's force and torque
+    (``walls.wall_forces``), external forces, gravity, then the central-difference update
+    with damping and the periodic wrap.
 
-    Writes the total force/torque (``force``, ``torque``), per-block wall sums
-    ``wsum[block, wall] = (Fx, Fy, Fz, touching, sum kn)`` and per-block ``drift`` (largest
-    move plus growth since the last neighbour build, m). Blocks of ``BLOCK`` particles are
-    summed in order, so the results are the same on any number of threads.
+    Writes the total force/torque (``force``, ``torque``) and per-block ``drift`` (largest
+    move plus growth since the last neighbour build, m). Each particle sums its terms in a
+    fixed order, so the results are the same on any number of threads.
     """
     n = pos.shape[0]
-    nw = wpoint.shape[0]
     nblocks = (n + BLOCK - 1) // BLOCK
     h = 0.5 * viscous * dt
     a = (1.0 - h) / (1.0 + h)
     b = dt / (1.0 + h)
     for blk in prange(nblocks):
-        for w in range(nw):
-            for k in range(5):
-                wsum[blk, w, k] = 0.0
         dmax = 0.0
         f = np.empty(3)
         t = np.empty(3)
@@ -87,33 +81,9 @@ def advance(pos, vel, omega, radius, mass, inertia, mat, fixed, start, rev_start
                 for k in range(3):
                     f[k] += fpair[p, k]
                     t[k] += tpair_j[p, k]
-            for w in range(nw):
-                gap = ((pos[i, 0] - wpoint[w, 0]) * wnormal[w, 0]
-                       + (pos[i, 1] - wpoint[w, 1]) * wnormal[w, 1]
-                       + (pos[i, 2] - wpoint[w, 2]) * wnormal[w, 2]) - radius[i]
-                if gap >= 0.0 and winfo[w, i, 0] <= 0.0:
-                    continue  # apart now and before: nothing to update
-                hit, f0, f1, f2, t0, t1, t2, delta, fn, energy, kn = wall_contact(
-                    pos[i, 0], pos[i, 1], pos[i, 2], vel[i, 0], vel[i, 1], vel[i, 2],
-                    omega[i, 0], omega[i, 1], omega[i, 2], radius[i], mass[i], inertia[i],
-                    mat[i], wpoint[w], wnormal[w], wvel[w], wmat[w], whist[w, i], pairtab,
-                    elin, dim, thickness, dt)
-                winfo[w, i, 0] = delta
-                winfo[w, i, 1] = fn
-                winfo[w, i, 2] = energy
-                winfo[w, i, 3] = kn
-                if hit:
-                    f[0] -= f0
-                    f[1] -= f1
-                    f[2] -= f2
-                    t[0] += t0
-                    t[1] += t1
-                    t[2] += t2
-                    wsum[blk, w, 0] += f0
-                    wsum[blk, w, 1] += f1
-                    wsum[blk, w, 2] += f2
-                    wsum[blk, w, 3] += 1.0
-                    wsum[blk, w, 4] += kn
+            for k in range(3):
+                f[k] += wforce[i, k]
+                t[k] += wtorque[i, k]
             for k in range(3):
                 force[i, k] = f[k] - mass[i] * gravity[k]
                 torque[i, k] = t[k]

@@ -17,9 +17,10 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 from tribodem.dem.contact import P_LAW, contact_response
+from tribodem.dem.jit import kernel
 
 WALL_MODES = ("fixed", "velocity", "servo", "boundary")
 
@@ -202,3 +203,97 @@ def wall_arrays(walls: list[PlaneWall]) -> tuple[np.ndarray, ...]:
     return (np.array([w.point for w in walls]), np.array([w.normal for w in walls]),
             np.array([w.velocity for w in walls]),
             np.array([w.material for w in walls], dtype=np.int64))
+
+
+# ---------------------------------------------------------------------------- the wall pass
+# Plane walls are their own force pass over a near-wall list built with the neighbour list:
+# (particle, wall) candidates whose gap was below the skin at the build. Between builds every
+# particle moves less than skin/2 (the neighbour list's trigger) and every wall less than
+# skin/2 along its normal (``Simulation._maybe_rebuild``), so no contact is missed.
+
+
+@njit(cache=True)
+def near_walls(pos, radius, wpoint, wnormal, reach):
+    """CSR of the walls within ``reach`` (m, gap = distance - radius) of each particle, in
+    wall order: walls of particle i are ``wid[wstart[i]:wstart[i+1]]``."""
+    n = pos.shape[0]
+    nw = wpoint.shape[0]
+    wstart = np.zeros(n + 1, dtype=np.int64)
+    for i in range(n):
+        c = 0
+        for w in range(nw):
+            gap = ((pos[i, 0] - wpoint[w, 0]) * wnormal[w, 0]
+                   + (pos[i, 1] - wpoint[w, 1]) * wnormal[w, 1]
+                   + (pos[i, 2] - wpoint[w, 2]) * wnormal[w, 2]) - radius[i]
+            if gap < reach:
+                c += 1
+        wstart[i + 1] = wstart[i] + c
+    wid = np.empty(wstart[n], dtype=np.int64)
+    for i in range(n):
+        q = wstart[i]
+        for w in range(nw):
+            gap = ((pos[i, 0] - wpoint[w, 0]) * wnormal[w, 0]
+                   + (pos[i, 1] - wpoint[w, 1]) * wnormal[w, 1]
+                   + (pos[i, 2] - wpoint[w, 2]) * wnormal[w, 2]) - radius[i]
+            if gap < reach:
+                wid[q] = w
+                q += 1
+    return wstart, wid
+
+
+@kernel(chunk=2)
+def wall_forces(pos, vel, omega, radius, mass, inertia, mat, wstart, wid, wpoint, wnormal,
+                wvel, wmat, whist, winfo, wsum, pairtab, elin, dim, thickness, dt, block,
+                wforce, wtorque):
+    """Contacts of the near-wall candidates: per particle, the sum over its walls (in wall
+    order) of the force (N) and torque (N m) on it -> ``wforce``/``wtorque`` (rows of
+    particles without candidates are left as they are: zero); per-block wall sums
+    ``wsum[block, wall] = (Fx, Fy, Fz, touching, sum kn)`` (blocks of ``block`` particles,
+    summed in order: the same on any number of threads); ``winfo[w, i]`` = (overlap m,
+    normal force N, energy J, kn N/m) and the shear history ``whist[w, i]`` updated."""
+    n = pos.shape[0]
+    nw = wpoint.shape[0]
+    nblocks = (n + block - 1) // block
+    for blk in prange(nblocks):
+        for w in range(nw):
+            for k in range(5):
+                wsum[blk, w, k] = 0.0
+        for i in range(blk * block, min(n, (blk + 1) * block)):
+            a, b = wstart[i], wstart[i + 1]
+            if a == b:
+                continue
+            f0s = f1s = f2s = t0s = t1s = t2s = 0.0
+            for c in range(a, b):
+                w = wid[c]
+                gap = ((pos[i, 0] - wpoint[w, 0]) * wnormal[w, 0]
+                       + (pos[i, 1] - wpoint[w, 1]) * wnormal[w, 1]
+                       + (pos[i, 2] - wpoint[w, 2]) * wnormal[w, 2]) - radius[i]
+                if gap >= 0.0 and winfo[w, i, 0] <= 0.0:
+                    continue  # apart now and before: nothing to update
+                hit, f0, f1, f2, t0, t1, t2, delta, fn, energy, kn = wall_contact(
+                    pos[i, 0], pos[i, 1], pos[i, 2], vel[i, 0], vel[i, 1], vel[i, 2],
+                    omega[i, 0], omega[i, 1], omega[i, 2], radius[i], mass[i], inertia[i],
+                    mat[i], wpoint[w], wnormal[w], wvel[w], wmat[w], whist[w, i], pairtab,
+                    elin, dim, thickness, dt)
+                winfo[w, i, 0] = delta
+                winfo[w, i, 1] = fn
+                winfo[w, i, 2] = energy
+                winfo[w, i, 3] = kn
+                if hit:
+                    f0s -= f0
+                    f1s -= f1
+                    f2s -= f2
+                    t0s += t0
+                    t1s += t1
+                    t2s += t2
+                    wsum[blk, w, 0] += f0
+                    wsum[blk, w, 1] += f1
+                    wsum[blk, w, 2] += f2
+                    wsum[blk, w, 3] += 1.0
+                    wsum[blk, w, 4] += kn
+            wforce[i, 0] = f0s
+            wforce[i, 1] = f1s
+            wforce[i, 2] = f2s
+            wtorque[i, 0] = t0s
+            wtorque[i, 1] = t1s
+            wtorque[i, 2] = t2s
