@@ -212,3 +212,84 @@ def test_cli_refuses_bad_input(tmp_path: Path) -> None:
     bad.write_text("[condition]\nload_kN = 13.0\n")  # no speed
     r = _cli("run", "--config", str(bad), "--out", str(tmp_path / "z"))
     assert r.returncode == 2 and "speed" in r.stderr
+
+
+def _tiny(change: dict | None = None) -> RunSetup:
+    kw = dict(pressure_Pa=0.53e6, speed_m_s=47.12, duration_s=1e-6, geometry=SMALL,
+              condition=5, samples=12, vtk_snapshots=3, figures=False)
+    return RunSetup(**{**kw, **(change or {})})
+
+
+def test_resume_in_process_equals_the_uninterrupted_run(tmp_path: Path,
+                                                        monkeypatch: pytest.MonkeyPatch
+                                                        ) -> None:
+    """Interrupted at the 8th sample (after the checkpoint of sample 6), then resumed:
+    rows, pvd indexes, snapshots and summary are bitwise the uninterrupted run's."""
+    import tribodem.braking.run as run_mod
+    from tribodem.braking.run import read_checkpoint
+
+    full = run_braking(_tiny(), tmp_path / "a")
+    real = run_mod.measure
+    calls = [0]
+
+    def interrupted(*a: object, **k: object) -> dict:
+        calls[0] += 1
+        if calls[0] == 8:
+            raise KeyboardInterrupt
+        return real(*a, **k)
+
+    monkeypatch.setattr(run_mod, "measure", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        run_braking(_tiny(), tmp_path / "b")
+    monkeypatch.setattr(run_mod, "measure", real)
+    rec = read_checkpoint(tmp_path / "b" / "checkpoint.npz")
+    assert 0 < rec["done"] < rec["total_steps"] and not rec["finished"]
+    # checkpoint_every and figures may change on resume; the physics may not
+    res = run_braking(_tiny({"checkpoint_every": 5}), tmp_path / "b", resume=True)
+    for k, v in full.items():
+        if not k.startswith("wall_time"):
+            assert repr(res[k]) == repr(v), k
+    for f in ("timeseries.csv", "vtk/particles.pvd", "vtk/chains.pvd",
+              "vtk/particles_0002.vtu", "vtk/chains_0001.vtu"):
+        assert (tmp_path / "a" / f).read_bytes() == (tmp_path / "b" / f).read_bytes(), f
+    from tribodem.io.config import ConfigError
+
+    with pytest.raises(ConfigError, match=r"samples = 13 differs .* 12"):
+        run_braking(_tiny({"samples": 13}), tmp_path / "b", resume=True)
+
+
+def test_instability_keeps_rows_and_a_stopped_summary(tmp_path: Path,
+                                                      monkeypatch: pytest.MonkeyPatch) -> None:
+    from tribodem.dem import Simulation, SimulationUnstable
+
+    real = Simulation.step
+    calls = [0]
+
+    def unstable(self: Simulation, n: int = 1) -> None:
+        sliding = any(type(x).__name__ == "_Loop" for x in self.interactions)
+        calls[0] += sliding
+        if sliding and calls[0] == 4:
+            raise SimulationUnstable("particle 7 moved more than its radius in one step")
+        real(self, n)
+
+    monkeypatch.setattr(Simulation, "step", unstable)
+    with pytest.raises(SimulationUnstable):
+        run_braking(_tiny(), tmp_path)
+    s = json.loads((tmp_path / "summary.json").read_text())
+    assert s["status"] == "stopped" and "particle 7" in s["stopped_reason"]
+    ts = np.genfromtxt(tmp_path / "timeseries.csv", delimiter=",", names=True)
+    assert ts.size == s["steps"] // (s["steps_planned"] // 12) + 1 >= 3
+    assert s["last_checkpoint"] is not None
+
+
+def test_quick_preset_overrides_the_config_file(tmp_path: Path) -> None:
+    from tribodem.braking.cli import QUICK, _config
+
+    cfg = tmp_path / "c.toml"
+    cfg.write_text("[run]\nduration_s = 1e-6\nsamples = 7\n[condition]\nindex = 2\n")
+    c = _config(None, cfg, quick=False)
+    assert c.run.duration_s == 1e-6 and c.run.samples == 7
+    q = _config(4, cfg, quick=True)  # defaults < file < --quick < --condition
+    assert q.run.duration_s == QUICK["run"]["duration_s"]
+    assert q.run.samples == QUICK["run"]["samples"] and q.condition.index == 4
+    assert _config(None, None, quick=True).run.samples == QUICK["run"]["samples"]

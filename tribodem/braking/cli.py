@@ -1,4 +1,25 @@
-"""``tribodem braking run`` and ``tribodem braking sweep`` (seed 000 sections 3.2-5, table 4)."""
+"""``tribodem braking run`` and ``tribodem braking sweep`` (seed 000 sections 3.2-5, table 4).
+
+Configuration: defaults < ``--config`` file < ``--quick`` preset < ``--condition``. The
+resolved config is written to ``<out>/config.toml`` and reloads to the same config.
+
+Life of a run (``tribodem.io.runs`` vocabulary): the inputs and ``--out`` are checked before
+any work (exit 2); ``<out>/checkpoint.npz`` is written after the first sample, every
+``run.checkpoint_every`` samples (default: about every 10% of the run) and at the end;
+``--resume`` continues from it (its own config.toml, or a ``--config``/``--condition``
+that must resolve to the checkpoint's config except ``run.threads``,
+``run.checkpoint_every``, ``run.figures``; anything else: exit 2, nothing touched) to
+bitwise the results of an uninterrupted run; resuming a finished run only reports it.
+Without ``--resume`` a run in ``--out`` is replaced. Ctrl-C exits 130 naming the outputs
+and the checkpoint; an instability exits 3 after writing the rows so far and a summary with
+``status = "stopped"``.
+
+A sweep runs each (condition, seed) member in its own folder; re-running the same sweep
+skips members whose summary.json is finished with the same config, resumes the others
+from their checkpoints and starts over those whose config changed. Ctrl-C cancels the
+pending members and kills the workers; a failed member is reported (comparison.md, stderr)
+and the comparison covers the others (exit 3).
+"""
 
 from __future__ import annotations
 
@@ -68,6 +89,10 @@ class RunCfg(_Strict):
     dt_safety: float = Field(0.3, gt=0, le=1)
     threads: int = Field(0, ge=0, le=256, description="0 = all cores")
     figures: bool = True
+    checkpoint_every: int = Field(
+        0, ge=0, le=100_000,
+        description="samples between checkpoints (checkpoint.npz in the output folder); "
+                    "0 = ceil(samples / 10), about every 10% of the run")
 
 
 class ThermalCfg(_Strict):
@@ -144,23 +169,75 @@ def setup_from_config(cfg: BrakingConfig) -> Any:
                     plate_areal_mass=r.plate_areal_mass_kg_m2 or None, backing=r.backing,
                     local_damping=r.local_damping, dt_safety=r.dt_safety,
                     thermal_curve=curve, thermal_time_map=cfg.thermal.time_map,
-                    figures=r.figures)
+                    figures=r.figures, checkpoint_every=r.checkpoint_every)
 
 
-def _config(condition: int | None, config: Path | None, quick: bool) -> BrakingConfig:
-    data = load_toml(config) if config else {}
+#: config fields a resumed run may change (they do not change the results)
+RESUME_FREE = ("run.threads", "run.checkpoint_every", "run.figures")
+#: what ``braking run`` prints of the summary
+_SHOWN = ("status", "condition", "pressure_Pa", "sliding_speed_m_s", "simulated_time_s",
+          "simulated_sliding_distance_m", "wear_depth_mean_m", "wear_depth_max_m",
+          "broken_bonds", "debris_particles", "force_chains", "particles_initial",
+          "particles_final", "mean_wall_pressure_ratio", "wall_time_s")
+
+
+def _config(condition: int | None, config: Path | None, quick: bool,
+            base: dict[str, Any] | None = None, source: str = "braking") -> BrakingConfig:
+    """Defaults <- config file (or ``base``: a resumed run's own config) <- ``--quick``
+    preset <- ``--condition``."""
+    if config is not None:
+        data, source = load_toml(config), str(config)
+    else:
+        data = base or {}
     if quick:
-        data = merge(QUICK, data)
+        data = merge(data, QUICK) if (config is not None or base) else merge(QUICK, data)
     if condition is not None:
         data = merge(data, {"condition": {"index": condition}})
-    return validate(BrakingConfig, data, source=str(config) if config else "braking")
+    return validate(BrakingConfig, data, source=source)
 
 
-def _run_one(cfg_data: dict[str, Any], out: str, threads: int) -> dict[str, Any]:
-    """Worker: one run in its own process (sweep)."""
+def config_differences(old: dict[str, Any], new: dict[str, Any]) -> list[tuple[str, Any, Any]]:
+    """(field, old, new) of the resolved configs that differ, ``RESUME_FREE`` left out."""
+    from tribodem.braking.run import differences
+
+    return [d for d in differences(old, new) if d[0] not in RESUME_FREE]
+
+
+def _checkpoint_config(rec: dict[str, Any], path: Path) -> dict[str, Any] | None:
+    """The resolved config a checkpoint's run was made with (None when it has none)."""
+    if rec.get("config") is None:
+        return None
+    return validate(BrakingConfig, rec["config"], source=f"checkpoint '{path}'").model_dump()
+
+
+def _check_same(cfg: BrakingConfig, old: dict[str, Any] | None, path: Path) -> None:
+    if old is None:
+        return
+    diff = config_differences(old, cfg.model_dump())
+    if diff:
+        name, a, b = diff[0]
+        more = f" (and {len(diff) - 1} more)" if len(diff) > 1 else ""
+        raise ConfigError(
+            f"--resume: {name} = {b!r} differs from the checkpointed run's {a!r}{more} "
+            f"('{path}'); allowed: the same value (only {', '.join(RESUME_FREE)} may change)")
+
+
+def _finished_summary(out: Path) -> dict[str, Any] | None:
+    """The run's summary.json when it is complete (``status`` finished), else None."""
+    try:
+        s = json.loads((out / "summary.json").read_text())
+    except (OSError, ValueError):
+        return None
+    return s if isinstance(s, dict) and s.get("status") == "finished" else None
+
+
+def _run_one(cfg_data: dict[str, Any], out: str, threads: int, resume: bool = False,
+             progress: bool = False) -> dict[str, Any]:
+    """One run in ``out`` (the ``braking run`` command and each sweep worker): writes the
+    resolved config.toml, then runs (``resume``: from ``out/checkpoint.npz``)."""
     import numba
 
-    from tribodem.braking.run import run_braking
+    from tribodem.braking.run import CHECKPOINT, run_braking
 
     if threads:
         numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
@@ -168,66 +245,215 @@ def _run_one(cfg_data: dict[str, Any], out: str, threads: int) -> dict[str, Any]
     setup = setup_from_config(cfg)
     o = Path(out)
     o.mkdir(parents=True, exist_ok=True)
-    write_text(o / "config.toml", dump_toml(cfg.model_dump(exclude_none=True)))
-    return run_braking(setup, o)
+    if not resume:  # a new run replaces an earlier one: never leave its results as ours
+        for name in ("summary.json", CHECKPOINT):
+            (o / name).unlink(missing_ok=True)
+    text = dump_toml(cfg.model_dump())
+    own = o / "config.toml"
+    if not (own.is_file() and own.read_text() == text):  # a resume leaves it untouched
+        write_text(own, text)
+    return run_braking(setup, o, resume=resume, progress=progress, config=cfg.model_dump())
 
 
 @braking_app.command("run")
 def braking_run(
-    out: Path = typer.Option(..., "--out", help="Output directory."),
+    out: Path = typer.Option(..., "--out", help="Output directory (an earlier run there is "
+                             "replaced unless --resume)."),
     condition: int | None = typer.Option(None, "--condition", help="Table 4 condition 1..5."),
     config: Path | None = typer.Option(None, "--config", help="TOML config file."),
-    quick: bool = typer.Option(False, "--quick", help="Small, fast variant (< 3 min)."),
+    quick: bool = typer.Option(False, "--quick", help="Small, fast variant (< 3 min); it "
+                               "overrides the config file, --condition overrides both."),
+    resume: bool = typer.Option(False, "--resume", help="Continue the run in --out from its "
+                                "checkpoint (its own config.toml unless --config/--condition "
+                                "are given, which must match it)."),
+    progress: bool = typer.Option(True, "--progress/--no-progress",
+                                  help="Progress bar with ETA on stderr."),
 ) -> None:
-    """One interface run: summary.json, timeseries.csv, PNG figures, vtk/ snapshots."""
+    """One interface run: summary.json, timeseries.csv, PNG figures, vtk/ snapshots,
+    checkpoint.npz (resumable with --resume)."""
     from tribodem.braking.conditions import CONDITIONS
+    from tribodem.braking.run import CHECKPOINT, read_checkpoint
+    from tribodem.io import runs
 
     if condition is not None and condition not in CONDITIONS:
         raise ConfigError(f"braking run: --condition = {condition!r}: must be one of "
                           f"{sorted(CONDITIONS)} (seed 000 table 4)")
-    if condition is None and config is None:
+    if condition is None and config is None and not resume:
         raise ConfigError("braking run: give --condition 1..5 or --config FILE")
-    cfg = _config(condition, config, quick)
-    setup_from_config(cfg)  # refuse a bad condition before any work
-    summary = _run_one(cfg.model_dump(), str(out), cfg.run.threads)
-    typer.echo(json.dumps({k: summary[k] for k in (
-        "condition", "pressure_Pa", "sliding_speed_m_s", "simulated_time_s",
-        "simulated_sliding_distance_m", "wear_depth_mean_m", "wear_depth_max_m",
-        "broken_bonds", "debris_particles", "force_chains", "particles_initial",
-        "particles_final", "mean_wall_pressure_ratio", "wall_time_s")}, indent=2))
+    ck = out / CHECKPOINT
+    rec: dict[str, Any] = {}
+    if resume:  # everything checked before any output is touched
+        runs.check_out_dir(out, "--out", resume=True, need=(CHECKPOINT,))
+        rec = read_checkpoint(ck)
+        old = _checkpoint_config(rec, ck)
+        own = out / "config.toml"
+        base = load_toml(own) if own.is_file() else old
+        if config is None and base is None:
+            raise ConfigError(f"--resume: '{out}' has no config.toml and the checkpoint no "
+                              "config; give the run's --config")
+        cfg = _config(condition, config, quick, base=base,
+                      source=str(own) if own.is_file() else f"checkpoint '{ck}'")
+        setup_from_config(cfg)
+        _check_same(cfg, old, ck)
+    else:
+        cfg = _config(condition, config, quick)
+        setup_from_config(cfg)  # refuse a bad condition before any work
+        runs.check_out_dir(out, "--out")
+    runs.announce(out, ck, resume_hint="add --resume to the same command")
+    if resume and rec.get("finished"):
+        done = _finished_summary(out)
+        if done is not None:
+            typer.echo(f"braking run: '{out}' is already finished ({rec['done']} steps); "
+                       "nothing to do", err=True)
+            typer.echo(json.dumps({k: done.get(k) for k in _SHOWN}, indent=2))
+            return
+    summary = _run_one(cfg.model_dump(), str(out), cfg.run.threads, resume=resume,
+                       progress=progress)
+    typer.echo(json.dumps({k: summary[k] for k in _SHOWN}, indent=2))
+
+
+def _member_plan(cfg_data: dict[str, Any], d: Path) -> tuple[str, Any]:
+    """What a sweep member needs: ("done", summary) when ``d`` holds its finished run with
+    the same config, ("resume", None) when it holds a usable checkpoint of it, else
+    ("new", why-not-reused or None)."""
+    from tribodem.braking.run import CHECKPOINT, read_checkpoint
+
+    new = validate(BrakingConfig, cfg_data, source="sweep").model_dump()
+    own = d / "config.toml"
+    if not own.is_file():
+        return "new", None
+    try:
+        old = validate(BrakingConfig, load_toml(own), source=str(own)).model_dump()
+    except ConfigError:
+        return "new", "its config.toml cannot be read"
+    diff = config_differences(old, new)
+    if diff:
+        return "new", f"{diff[0][0]} changed from {diff[0][1]!r} to {diff[0][2]!r}"
+    done = _finished_summary(d)
+    if done is not None:
+        return "done", done
+    ck = d / CHECKPOINT
+    if not ck.is_file():
+        return "new", None
+    try:
+        rec = read_checkpoint(ck)
+        ck_cfg = _checkpoint_config(rec, ck)
+    except ConfigError as err:
+        return "new", str(err)
+    if ck_cfg is not None and config_differences(ck_cfg, new):
+        return "new", "its checkpoint belongs to another config"
+    return "resume", None
+
+
+def _ignore_sigint() -> None:
+    """Sweep workers leave Ctrl-C to the main process, which stops them."""
+    import signal
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+def _stop_pool(ex: ProcessPoolExecutor) -> None:
+    """Cancel the pending members and kill the worker processes now."""
+    procs = list((getattr(ex, "_processes", None) or {}).values())
+    ex.shutdown(wait=False, cancel_futures=True)
+    for pr in procs:
+        if pr.is_alive():
+            pr.kill()
+    for pr in procs:
+        pr.join(timeout=5)
 
 
 @braking_app.command("sweep")
 def braking_sweep(
-    out: Path = typer.Option(..., "--out", help="Output directory."),
+    out: Path = typer.Option(..., "--out", help="Output directory; re-running the same sweep "
+                             "there skips finished members and resumes the others."),
     config: Path | None = typer.Option(None, "--config", help="TOML config (condition ignored)."),
-    quick: bool = typer.Option(False, "--quick", help="Small, fast variant (< 3 min)."),
+    quick: bool = typer.Option(False, "--quick", help="Small, fast variant (< 3 min); it "
+                               "overrides the config file."),
     workers: int = typer.Option(2, "--workers", min=1, max=64, help="Parallel processes."),
     seeds: int = typer.Option(1, "--seeds", min=1, max=100,
                               help="Packing/roughness realisations per condition (averaged)."),
+    progress: bool = typer.Option(True, "--progress/--no-progress",
+                                  help="Progress bar (members done / total) on stderr."),
 ) -> None:
-    """Conditions 1-5 in parallel: comparison.csv, comparison.md (ours beside the seed's)."""
+    """Conditions 1-5 in parallel: comparison.csv, comparison.md (ours beside the seed's).
+
+    Each (condition, seed) member runs in its own folder with its own checkpoints; a
+    re-run with the same --out skips the finished members, resumes the unfinished ones
+    and starts over those whose config changed. A failed member is reported and left out
+    of the comparison (exit 3 at the end)."""
+    from concurrent.futures import as_completed
+
     from tribodem.braking.compare import write_comparison
+    from tribodem.io import runs
+    from tribodem.io.runs import RunStopped
 
     base = _config(None, config, quick).model_dump()
     base["condition"] = {}
+    runs.check_out_dir(out, "--out")
+    runs.announce(out)
     seed0 = int(base["geometry"]["seed"])
     t0 = time.perf_counter()
-    out.mkdir(parents=True, exist_ok=True)
-    jobs = {}
-    with ProcessPoolExecutor(max_workers=workers) as ex:
-        for s in range(seeds):
-            for k in range(1, 6):
-                data = merge(base, {"condition": {"index": k},
-                                    "geometry": {"seed": seed0 + s}})
-                d = out / f"condition_{k}" if seeds == 1 else out / f"condition_{k}" / f"seed_{s}"
-                jobs[(k, s)] = (ex.submit(_run_one, data, str(d), 1), d)
-        runs: dict[int, list[tuple[dict[str, Any], Path]]] = {k: [] for k in range(1, 6)}
-        for (k, _s), (f, d) in jobs.items():
-            runs[k].append((f.result(), d))
+    members: list[tuple[int, int, dict[str, Any], Path]] = []
+    for s in range(seeds):
+        for k in range(1, 6):
+            data = merge(base, {"condition": {"index": k}, "geometry": {"seed": seed0 + s}})
+            setup_from_config(validate(BrakingConfig, data, source="sweep"))
+            d = out / f"condition_{k}" if seeds == 1 else out / f"condition_{k}" / f"seed_{s}"
+            members.append((k, s, data, d))
+    results: dict[tuple[int, int], dict[str, Any]] = {}
+    failed: dict[tuple[int, int], str] = {}
+    todo = []
+    for k, s, data, d in members:
+        what, info = _member_plan(data, d)
+        name = d.relative_to(out)
+        if what == "done":
+            results[(k, s)] = info
+            typer.echo(f"  {name}: finished earlier, skipped")
+        else:
+            if what == "resume":
+                typer.echo(f"  {name}: resuming from its checkpoint")
+            elif info:
+                typer.echo(f"  {name}: starting over ({info})")
+            todo.append((k, s, data, d, what == "resume"))
+    if todo:
+        ex = ProcessPoolExecutor(max_workers=min(workers, len(todo)),
+                                 initializer=_ignore_sigint)
+        try:
+            futs = {ex.submit(_run_one, data, str(d), 1, res): (k, s)
+                    for k, s, data, d, res in todo}
+            with runs.progress(len(members), "run", "braking sweep", enabled=progress,
+                               initial=len(results)) as bar:
+                for f in as_completed(futs):
+                    key = futs[f]
+                    try:
+                        results[key] = f.result()
+                    except Exception as err:  # noqa: BLE001 - reported, the rest go on
+                        failed[key] = f"{type(err).__name__}: {err}"
+                        typer.echo(f"  condition {key[0]} seed {key[1]}: failed: "
+                                   f"{failed[key]}", err=True)
+                    bar.update(1)
+        except BaseException:  # Ctrl-C (or anything): stop the workers now, then re-raise
+            _stop_pool(ex)
+            typer.echo("\nsweep stopped: finished members are kept; run the same command "
+                       "again to skip them and resume the others from their checkpoints",
+                       err=True)
+            raise
+        ex.shutdown(wait=True)
     wall = time.perf_counter() - t0
-    rows = write_comparison(out, runs, wall, workers, quick)
+    runs_by_k: dict[int, list[tuple[dict[str, Any], Path]]] = {}
+    for k, s, _data, d in members:
+        if (k, s) in results:
+            runs_by_k.setdefault(k, []).append((results[(k, s)], d))
+    fails = {f"condition {k} seed {s}": msg for (k, s), msg in sorted(failed.items())}
+    rows = write_comparison(out, runs_by_k, wall, workers, quick, failed=fails) \
+        if runs_by_k else []
+    skipped = len(members) - len(todo)
     typer.echo(f"sweep: 5 conditions x {seeds} seed(s) in {wall:.1f} s on {workers} workers "
-               f"-> {out / 'comparison.md'}")
+               f"({len(todo)} run, {skipped} skipped as finished) -> {out / 'comparison.md'}")
     for r in rows:
         typer.echo(f"  {r[0]}: ours {r[1]}, seed {r[2]}")
+    if failed:
+        first = next(iter(fails.items()))
+        raise RunStopped(f"{len(failed)} of {len(members)} sweep members failed (first: "
+                         f"{first[0]}: {first[1]}); the comparison covers the others")

@@ -119,10 +119,19 @@ def _pm(pct: float, se: float) -> str:
 
 
 def write_comparison(out: Path, runs: dict[int, list[tuple[dict[str, Any], Path]]],
-                     wall_s: float, workers: int, quick: bool) -> list[tuple[str, str, str]]:
+                     wall_s: float, workers: int, quick: bool,
+                     failed: dict[str, str] | None = None) -> list[tuple[str, str, str]]:
     """Write comparison.csv and comparison.md from the runs of each condition (one per
     packing seed): seed means, the standard error of each change over seeds, and a
-    verdict per change and per trend; return (label, ours, seed) wear rows."""
+    verdict per change and per trend; return (label, ours, seed) wear rows.
+
+    ``failed`` (member -> error) is listed; a condition without any run (all its members
+    failed) leaves the changes and trends that need it unevaluated ("-")."""
+    runs = {k: v for k, v in runs.items() if v}
+    if not runs:
+        raise ValueError("write_comparison: no runs")
+    nan = (float("nan"), float("nan"))
+    missing = [k for k in CONDITIONS if k not in runs]
     results = {k: _mean_summary([r for r, _ in v]) for k, v in runs.items()}
     n_seeds = min(len(v) for v in runs.values())
     series = {k: _series(v[0][1]) for k, v in runs.items()}  # condition 5 history: seed 0
@@ -135,6 +144,8 @@ def write_comparison(out: Path, runs: dict[int, list[tuple[dict[str, Any], Path]
         "strong": {k: np.array([_late_mean(_series(d), "strong_force_chains") for _, d in v])
                    for k, v in runs.items()},
     }
+    for q in per_seed:
+        per_seed[q].update({k: np.full(1, np.nan) for k in missing})
     wear = {k: float(x.mean()) for k, x in per_seed["wear"].items()}
     spread = {k: float(x.std(ddof=1)) if x.size > 1 else float("nan")
               for k, x in per_seed["wear"].items()}
@@ -145,6 +156,7 @@ def write_comparison(out: Path, runs: dict[int, list[tuple[dict[str, Any], Path]
     strong = {k: float(x.mean()) for k, x in per_seed["strong"].items()}
     ch: dict[str, dict[tuple[int, int], tuple[float, float]]] = {
         q: {(a, b): change_with_error(per_seed[q][a], per_seed[q][b])
+            if a in runs and b in runs else nan
             for _, a, b, _, _ in SEED_CHANGES} for q in per_seed}
     rows_csv = []
     lines = []
@@ -173,6 +185,9 @@ def write_comparison(out: Path, runs: dict[int, list[tuple[dict[str, Any], Path]
 
     def trend(q: str, ks: tuple[int, int, int], want: str) -> str:
         a, b, c = ks
+        lost = [k for k in ks if k in missing]
+        if lost:
+            return f"not evaluated: no run of condition {', '.join(map(str, lost))}"
         return trend_verdict([ch[q][(a, b)], ch[q][(b, c)]], ch[q][(a, c)], want, n_seeds)
 
     verdicts = [
@@ -187,11 +202,11 @@ def write_comparison(out: Path, runs: dict[int, list[tuple[dict[str, Any], Path]
         ("force chains fall with speed (seed -15.58%, -3.86%)",
          trend("chains", (3, 4, 5), "down")),
     ]
-    r5 = results[5]
-    s5 = series[5]
-    t_sim = float(r5["simulated_time_s"])
+    r5 = results.get(5)
+    s5 = series.get(5)
+    t_sim = float(next(iter(results.values()))["simulated_time_s"])
     hist = []
-    for ts, hs in SEED_FIG12:
+    for ts, hs in SEED_FIG12 if s5 is not None else []:
         tt = ts / SEED_BRAKING_TIME_S * t_sim
         h = float(np.interp(tt, s5["time_s"], s5["wear_depth_mean_m"]))
         hist.append(f"| {ts:g} | {hs * 1e3:.3g} | {tt * 1e6:.3g} | {h * 1e3:.3g} | "
@@ -226,6 +241,14 @@ def write_comparison(out: Path, runs: dict[int, list[tuple[dict[str, Any], Path]
                "error is that of the mean per-seed difference." if rel else
                "One packing per condition: the scatter between packings is not measured "
                "here (use --seeds N), so no change can be called resolved.")
+    extrap = (
+        f"Our linear extrapolation to 8 s (steady rate over the second half, clipped at "
+        f"0): {r5['wear_depth_mean_extrapolated_8s_m'] * 1e3:.3g} mm "
+        f"(rate {r5['steady_wear_rate_m_s']:.3g} m/s) vs the seed's 7.69e-2 mm: an "
+        "extrapolation over ~6 orders of magnitude in time, not a result."
+        if r5 is not None else "Condition 5 has no run (failed): no history.")
+    fail_lines = ["## Failed members", "", "Left out of every mean and change above:", "",
+                  *[f"- {m}: {e}" for m, e in failed.items()], ""] if failed else []
     text = "\n".join([
         "# Braking sweep: tribodem vs seed 000" + (" (--quick)" if quick else ""),
         "",
@@ -275,11 +298,9 @@ def write_comparison(out: Path, runs: dict[int, list[tuple[dict[str, Any], Path]
         "|---|---|---|---|---|---|",
         *hist,
         "",
-        f"Our linear extrapolation to 8 s (steady rate over the second half, clipped at "
-        f"0): {r5['wear_depth_mean_extrapolated_8s_m'] * 1e3:.3g} mm "
-        f"(rate {r5['steady_wear_rate_m_s']:.3g} m/s) vs the seed's 7.69e-2 mm: an "
-        "extrapolation over ~6 orders of magnitude in time, not a result.",
+        extrap,
         "",
+        *fail_lines,
     ])
     write_text(out / "comparison.md", text)
     return printed

@@ -269,6 +269,14 @@ class PadBacking:
         """Total force of the plate on the pad now (N): wall contacts + dashpots."""
         return float(self.wall.normal_force + self.reaction)
 
+    def state(self) -> dict[str, np.ndarray]:
+        """For checkpoints: the dashpots' last reaction and the plate's drive (N)."""
+        return {"backing": np.array([self.reaction, float(self.wall.target_force)])}
+
+    def set_state(self, s: dict[str, np.ndarray]) -> None:
+        """Restore what ``state`` returned."""
+        self.reaction, self.wall.target_force = (float(x) for x in s["backing"])
+
 
 def build_interface(geometry: Geometry, pressure_Pa: float, micro: str = "calibrated",
                     wall_mass_ratio: float = 0.05, dt_safety: float = 0.3,

@@ -7,13 +7,32 @@ hundreds of um). The simulated time IS the braking time it represents
 braking (377 m at 47 m/s) is out of reach; the summary reports the fraction simulated and,
 separately labelled, a linear extrapolation of the mean wear depth to 8 s from the steady
 wear rate (least-squares slope over the second half of the run).
+
+Checkpoints and resuming (``run_braking(..., resume=True)``, ``tribodem braking run
+--resume``): one file, ``<out>/checkpoint.npz``, written atomically by the engine's
+``Simulation.save_checkpoint`` after the first sample, every ``checkpoint_every`` samples
+(default ceil(samples / 10): about every 10% of the run) and at the end. Besides the
+engine state (particles, neighbour list, contact history, walls, bonds, thermal, the pad
+backing) it holds the braking loop's own state, carried by the ``_Loop`` interaction's
+``state()``: steps done, every sample row so far, the VTK index entries and counters, the
+figure frames, the reference positions, the wall-mean accumulator, the wall-time so far
+and the setup (JSON) the checkpoint belongs to. A resume rebuilds the interface from the
+same setup (the build is deterministic: same seed -> bitwise the same packing; checked
+against the stored reference positions), loads the checkpoint and continues: the rows,
+the ``.pvd`` indexes and the summary come out bitwise as in an uninterrupted run (the
+``wall_time*`` fields excepted). A setup that differs from the checkpoint's (anything but
+``checkpoint_every`` and ``figures``) or a checkpoint that cannot be read is refused with
+``ConfigError`` before any output is touched. ``timeseries.csv`` is rewritten (atomically)
+at every checkpoint and at most every 2 s of wall time in between; rows written after the
+last checkpoint are recomputed identically on resume.
 """
 
 from __future__ import annotations
 
+import json
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -31,12 +50,22 @@ from tribodem.braking.model import (
     start_sliding,
 )
 from tribodem.dem.thermal import Thermal, read_curve
+from tribodem.io import runs
+from tribodem.io.config import ConfigError
 from tribodem.io.results import write_csv, write_json
+from tribodem.io.runs import RunStopped
 from tribodem.io.vtk import write_lines, write_points, write_pvd
 
 #: heat capacities (J/(kg K)) of the thermal boundary option; the seed gives none:
 #: handbook values for structural steel and a Cu-based sintered material
 HEAT_CAPACITY = {DISC: 460.0, PAD: 400.0}
+
+#: the run's checkpoint in its output folder (see the module docstring)
+CHECKPOINT = "checkpoint.npz"
+LOOP_VERSION = 1
+LOOP_KEY = "braking_loop"
+#: ``RunSetup`` fields a resumed run may change: they do not change the results
+RESUME_FREE = ("checkpoint_every", "figures")
 
 
 @dataclass
@@ -59,16 +88,21 @@ class RunSetup:
     thermal_curve: Path | None = None
     thermal_time_map: str = "simulated"
     figures: bool = True
+    checkpoint_every: int = 0  # samples between checkpoints; 0: ceil(samples / 10)
 
 
-class _WallMean:
-    """An engine interaction that only averages the plate's force on the pad (N): wall
-    contacts plus the backing dashpots' reaction."""
+class _Loop:
+    """An engine interaction that averages the plate's force on the pad (N) every step --
+    wall contacts plus the backing dashpots' reaction -- and carries the braking loop's own
+    state (``record``: JSON-able, ``arrays``: numpy) into the engine checkpoint through
+    ``state``/``set_state``, so one atomic file holds everything a resumed run needs."""
 
     def __init__(self, iface: Interface) -> None:
         self.iface = iface
         self.total = 0.0
         self.n = 0
+        self.record: dict[str, Any] = {}
+        self.arrays: dict[str, np.ndarray] = {}
 
     def compute(self, sim: Any) -> None:
         self.total += plate_force(self.iface)
@@ -77,6 +111,80 @@ class _WallMean:
     @property
     def mean(self) -> float:
         return self.total / self.n if self.n else float("nan")
+
+    def state(self) -> dict[str, np.ndarray]:
+        """The wall-mean accumulator, the loop record (JSON) and the loop's arrays."""
+        out = {f"a_{k}": v for k, v in self.arrays.items()}
+        out["wall"] = np.array([self.total, float(self.n)])
+        out[LOOP_KEY] = np.array(json.dumps(self.record))
+        return out
+
+    def set_state(self, s: dict[str, np.ndarray]) -> None:
+        """Restore what ``state`` returned."""
+        self.total, n = (float(x) for x in s["wall"])
+        self.n = int(n)
+        self.record = json.loads(str(s[LOOP_KEY]))
+        self.arrays = {k[2:]: np.array(v) for k, v in s.items() if k.startswith("a_")}
+
+
+def differences(old: dict[str, Any], new: dict[str, Any], prefix: str = ""
+                ) -> list[tuple[str, Any, Any]]:
+    """(dotted name, old, new) of every entry that differs between two nested dicts."""
+    out: list[tuple[str, Any, Any]] = []
+    for k in sorted(set(old) | set(new), key=str):
+        a, b = old.get(k), new.get(k)
+        name = f"{prefix}{k}"
+        if isinstance(a, dict) and isinstance(b, dict):
+            out += differences(a, b, name + ".")
+        elif a != b:
+            out.append((name, a, b))
+    return out
+
+
+def setup_record(setup: RunSetup) -> dict[str, Any]:
+    """The setup as JSON data, without the fields a resumed run may change."""
+    d = asdict(setup)
+    for k in RESUME_FREE:
+        d.pop(k)
+    d["thermal_curve"] = None if setup.thermal_curve is None else str(setup.thermal_curve)
+    return json.loads(json.dumps(d))
+
+
+def read_checkpoint(path: str | Path) -> dict[str, Any]:
+    """The braking-loop record of a run's checkpoint. Every array is read (zip CRC), so a
+    truncated or corrupt file is refused (``ConfigError``) before any work."""
+    path = Path(path)
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            for k in z.files:
+                z[k]  # noqa: B018 - read it: checks the CRC
+            keys = [k for k in z.files if k.endswith("_" + LOOP_KEY)]
+            if not keys:
+                raise ValueError("it holds no braking-run state (not a braking checkpoint)")
+            rec = json.loads(str(z[keys[0]]))
+    except Exception as err:  # noqa: BLE001 - any unreadable file
+        raise ConfigError(f"checkpoint '{path}' cannot be read: {err}") from None
+    if rec.get("version") != LOOP_VERSION:
+        raise ConfigError(f"checkpoint '{path}' cannot be read: braking-loop version "
+                          f"{rec.get('version')!r}, expected {LOOP_VERSION}")
+    return rec
+
+
+def check_resumable(rec: dict[str, Any], setup: RunSetup, path: str | Path) -> None:
+    """``ConfigError`` naming the first setup field that differs from the checkpoint's run
+    (only ``checkpoint_every`` and ``figures`` may change)."""
+    diff = differences(rec["setup"], setup_record(setup))
+    if diff:
+        name, old, new = diff[0]
+        raise ConfigError(
+            f"--resume: {name} = {new!r} differs from the checkpointed run's {old!r} "
+            f"('{path}'); allowed: the same value (only {', '.join(RESUME_FREE)} may change)")
+
+
+def checkpoint_interval(setup: RunSetup) -> int:
+    """Samples between checkpoints: ``checkpoint_every``, or (0) ceil(samples / 10), i.e.
+    about every 10% of the run."""
+    return setup.checkpoint_every or max(1, math.ceil(setup.samples / 10))
 
 
 def body_displacement(iface: Interface, ref: Reference, slid: float) -> np.ndarray:
@@ -139,9 +247,21 @@ def wear_extrapolation(t: np.ndarray, h: np.ndarray, target_s: float) -> tuple[f
     return rate, float(h[-1] + max(rate, 0.0) * (target_s - t[-1]))
 
 
-def run_braking(setup: RunSetup, out: Path | None = None) -> dict[str, Any]:
+def run_braking(setup: RunSetup, out: Path | None = None, *, resume: bool = False,
+                progress: bool = False, config: dict[str, Any] | None = None
+                ) -> dict[str, Any]:
     """Run one braking interface simulation; write results to ``out`` (if given) and
-    return the summary dict."""
+    return the summary dict.
+
+    With ``out``: ``timeseries.csv`` is rewritten as the run goes (at every checkpoint and
+    at most every 2 s of wall time), a checkpoint ``out/checkpoint.npz`` is written after
+    the first sample, every ``checkpoint_interval(setup)`` samples and at the end, and
+    ``resume`` continues from it (bitwise the run an uninterrupted call gives; the
+    wall-time fields excepted). Without ``resume`` an earlier run in ``out`` is replaced.
+    An instability (``RunStopped``) is re-raised after the rows so far and a summary with
+    ``status = "stopped"`` are written. ``progress``: a bar over the sliding steps.
+    ``config``: the command's resolved config (JSON-able), kept in the checkpoint.
+    """
     for name, v in (("pressure_Pa", setup.pressure_Pa), ("speed_m_s", setup.speed_m_s),
                     ("duration_s", setup.duration_s)):
         if not v > 0:
@@ -149,6 +269,15 @@ def run_braking(setup: RunSetup, out: Path | None = None) -> dict[str, Any]:
     if setup.thermal_time_map not in ("simulated", "stretched"):
         raise ValueError(f"thermal_time_map = {setup.thermal_time_map!r}: must be "
                          "'simulated' or 'stretched'")
+    ck = out / CHECKPOINT if out is not None else None
+    saved: dict[str, Any] | None = None
+    if resume:
+        if ck is None:
+            raise ValueError("run_braking: resume needs the output folder 'out'")
+        if not ck.is_file():
+            raise ConfigError(f"--resume: no checkpoint at '{ck}'")
+        saved = read_checkpoint(ck)
+        check_resumable(saved, setup, ck)
     t_wall = time.perf_counter()
     iface = build_interface(setup.geometry, setup.pressure_Pa, setup.micro,
                             setup.wall_mass_ratio, setup.dt_safety, setup.local_damping,
@@ -161,19 +290,22 @@ def run_braking(setup: RunSetup, out: Path | None = None) -> dict[str, Any]:
         _thermal(iface, setup, t0)
     start_sliding(iface, setup.speed_m_s)
     ref = reference(iface)
-    wall_mean = _WallMean(iface)
-    sim.add_interaction(wall_mean)
+    loop = _Loop(iface)
+    sim.add_interaction(loop)
     wall_y0 = float(iface.wall.point[1])
     total_steps = max(1, int(math.ceil(setup.duration_s / sim.dt)))
     every = max(1, total_steps // max(1, setup.samples))
+    ck_every = checkpoint_interval(setup)
     vtk_at = set(np.linspace(0, total_steps, max(setup.vtk_snapshots, 0)).astype(int).tolist()
                  ) if setup.vtk_snapshots else set()
     rows: list[dict[str, float]] = []
     entries: list[tuple[float, str]] = []
     chain_entries: list[tuple[float, str]] = []
     frames: dict[str, dict[str, np.ndarray]] = {}
+    seen: set[int] = set()
     done = 0
     k_vtk = 0
+    wall_before = {"build": t_build, "sliding": 0.0, "total": 0.0}  # earlier sessions
 
     def sample() -> None:
         nonlocal k_vtk
@@ -185,7 +317,7 @@ def run_braking(setup: RunSetup, out: Path | None = None) -> dict[str, Any]:
                "wall_displacement_m": float(iface.wall.point[1]) - wall_y0,
                "kinetic_energy_J": sim.kinetic_energy()}
         row.update(measure(iface, ref, slid))
-        rows.append(row)
+        rows.append({k: float(v) for k, v in row.items()})
         if out is not None and any(done >= s and s not in seen for s in vtk_at):
             for s in vtk_at:
                 if done >= s:
@@ -193,19 +325,111 @@ def run_braking(setup: RunSetup, out: Path | None = None) -> dict[str, Any]:
             _snapshot(out / "vtk", iface, ref, slid, k_vtk, t, entries, chain_entries)
             k_vtk += 1
 
-    seen: set[int] = set()
-    sample()
-    frames["start"] = _frame(iface, ref, 0.0)
+    last_csv = time.monotonic()
+
+    def write_rows() -> None:
+        nonlocal last_csv
+        assert out is not None
+        write_csv(out / "timeseries.csv", list(rows[0]), [list(r.values()) for r in rows])
+        last_csv = time.monotonic()
+
     t_slide = time.perf_counter()
-    while done < total_steps:
-        k = min(every, total_steps - done)
-        sim.step(k)
-        done += k
+
+    def save_checkpoint() -> None:
+        assert ck is not None
+        cols = list(rows[0])
+        loop.record = {
+            "version": LOOP_VERSION, "setup": setup_record(setup), "config": config,
+            "done": done,
+            "total_steps": total_steps, "every": every, "n0": n0, "t0": t0,
+            "wall_y0": wall_y0, "k_vtk": k_vtk, "seen": sorted(seen),
+            "entries": entries, "chain_entries": chain_entries, "columns": cols,
+            "frames": {k: sorted(v) for k, v in frames.items()},
+            "finished": done >= total_steps,
+            "wall_time_build_s": wall_before["build"],
+            "wall_time_sliding_s": wall_before["sliding"] + time.perf_counter() - t_slide,
+            "wall_time_s": wall_before["total"] + time.perf_counter() - t_wall,
+        }
+        arrays = {"rows": np.array([[r[c] for c in cols] for r in rows], dtype=np.float64),
+                  "ref_pos": ref.pos, "ref_radius": ref.radius}
+        for name, fr in frames.items():
+            for key, v in fr.items():
+                arrays[f"frame_{name}_{key}"] = np.asarray(v)
+        loop.arrays = arrays
+        sim.save_checkpoint(ck)
+        runs.checkpoint_written(ck)
+
+    if saved is not None:
+        assert ck is not None
+        try:
+            sim.load_checkpoint(ck)
+        except Exception as err:  # noqa: BLE001 - a foreign or damaged checkpoint
+            raise ConfigError(f"checkpoint '{ck}' cannot be used: {err}") from None
+        r = loop.record
+        a = loop.arrays
+        if (r["total_steps"], r["every"], r["n0"]) != (total_steps, every, n0) or not (
+                np.array_equal(a["ref_pos"], ref.pos)
+                and np.array_equal(a["ref_radius"], ref.radius)):
+            raise ConfigError(f"checkpoint '{ck}' cannot be used: the interface rebuilt from "
+                              "the same setup differs from the checkpointed one (packing not "
+                              "reproduced on this machine); allowed: resume where it was made")
+        done, k_vtk, seen = int(r["done"]), int(r["k_vtk"]), set(r["seen"])
+        entries[:] = [(float(t), str(f)) for t, f in r["entries"]]
+        chain_entries[:] = [(float(t), str(f)) for t, f in r["chain_entries"]]
+        rows[:] = [dict(zip(r["columns"], (float(x) for x in row), strict=True))
+                   for row in a["rows"]]
+        for name, keys in r["frames"].items():
+            frames[name] = {k: a[f"frame_{name}_{k}"] for k in keys}
+        t0, wall_y0 = float(r["t0"]), float(r["wall_y0"])
+        wall_before = {"build": float(r["wall_time_build_s"]),
+                       "sliding": float(r["wall_time_sliding_s"]),
+                       "total": float(r["wall_time_s"])}
+        runs.checkpoint_written(ck)
+    else:
+        if out is not None:  # a new run replaces an earlier one in this folder
+            out.mkdir(parents=True, exist_ok=True)
+            for name in (CHECKPOINT, "summary.json"):
+                (out / name).unlink(missing_ok=True)
         sample()
-        if "early" not in frames and done >= 0.1 * total_steps:
-            frames["early"] = _frame(iface, ref, setup.speed_m_s * (sim.time - t0))
-    frames["end"] = _frame(iface, ref, setup.speed_m_s * (sim.time - t0))
-    slide_wall = time.perf_counter() - t_slide
+        frames["start"] = _frame(iface, ref, 0.0)
+        if out is not None:
+            save_checkpoint()
+            write_rows()
+    resumed_at = done
+    t_slide = time.perf_counter()
+    try:
+        with runs.progress(total_steps, "step", "braking run", enabled=progress,
+                           initial=done) as bar:
+            while done < total_steps:
+                k = min(every, total_steps - done)
+                sim.step(k)
+                done += k
+                sample()
+                if "early" not in frames and done >= 0.1 * total_steps:
+                    frames["early"] = _frame(iface, ref, setup.speed_m_s * (sim.time - t0))
+                bar.update(k)
+                if out is None or done >= total_steps:
+                    continue
+                if (len(rows) - 1) % ck_every == 0:
+                    save_checkpoint()
+                    write_rows()
+                elif time.monotonic() - last_csv > 2.0:
+                    write_rows()
+    except RunStopped as err:
+        if out is not None:
+            write_rows()
+            write_json(out / "summary.json", {
+                "status": "stopped", "stopped_reason": str(err), "condition": setup.condition,
+                "pressure_Pa": setup.pressure_Pa, "sliding_speed_m_s": setup.speed_m_s,
+                "steps": done, "steps_planned": total_steps,
+                "simulated_time_s": rows[-1]["time_s"],
+                "last_checkpoint": str(ck) if ck is not None and ck.is_file() else None})
+        raise
+    if "end" not in frames:
+        frames["end"] = _frame(iface, ref, setup.speed_m_s * (sim.time - t0))
+    if out is not None and (saved is None or resumed_at < total_steps):
+        save_checkpoint()  # the finished state: a later --resume only reports it
+    slide_wall = wall_before["sliding"] + time.perf_counter() - t_slide
     last = rows[-1]
     p = sim.p
     # the domain: above the disc's anchored (y-fixed) bottom layer, below the pressure wall
@@ -218,6 +442,7 @@ def run_braking(setup: RunSetup, out: Path | None = None) -> dict[str, Any]:
     hh = np.array([r["wear_depth_mean_m"] for r in rows])
     rate, h8 = wear_extrapolation(tt, hh, SEED_BRAKING_TIME_S)
     summary: dict[str, Any] = {
+        "status": "finished",
         "condition": setup.condition,
         "load_kN": pressure_to_load(setup.pressure_Pa),
         "pressure_Pa": setup.pressure_Pa,
@@ -250,9 +475,9 @@ def run_braking(setup: RunSetup, out: Path | None = None) -> dict[str, Any]:
         "plate_areal_mass_kg_m2": setup.plate_areal_mass,
         "plate_mass_kg": iface.stats["plate_mass_kg"],
         "plate_travel_m": wall_y0 - float(iface.wall.point[1]),
-        "mean_wall_force_N": wall_mean.mean,
-        "mean_wall_pressure_Pa": wall_mean.mean / (iface.width * iface.disc.thickness),
-        "mean_wall_pressure_ratio": wall_mean.mean / iface.target_force,
+        "mean_wall_force_N": loop.mean,
+        "mean_wall_pressure_Pa": loop.mean / (iface.width * iface.disc.thickness),
+        "mean_wall_pressure_ratio": loop.mean / iface.target_force,
         "steps": done,
         "dt_s": sim.dt,
         "dt_limited_by": sim.dt_limit_by,
@@ -266,9 +491,9 @@ def run_braking(setup: RunSetup, out: Path | None = None) -> dict[str, Any]:
                              "set": setup.micro},
         "thermal_curve": str(setup.thermal_curve) if setup.thermal_curve else None,
         "thermal_time_map": setup.thermal_time_map if setup.thermal_curve else None,
-        "wall_time_build_s": t_build,
+        "wall_time_build_s": wall_before["build"],
         "wall_time_sliding_s": slide_wall,
-        "wall_time_s": time.perf_counter() - t_wall,
+        "wall_time_s": wall_before["total"] + time.perf_counter() - t_wall,
         "assumptions": _assumptions(setup),
     }
     if out is not None:

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -53,18 +54,28 @@ class CalibrationResult:
     notes: list[str] = field(default_factory=list)
 
 
-def measure(specimens: list[Specimen], spec: MaterialSpec, **kw: float
+def measure(specimens: list[Specimen], spec: MaterialSpec,
+            on_test: Callable[[], None] | None = None, **kw: float
             ) -> tuple[float, float, list[CompressionResult]]:
-    """Mean E (Pa) and nu over the specimens re-bonded with ``spec`` (eq 12)."""
-    res = [run_compression(s.with_spec(spec), **kw) for s in specimens]  # type: ignore[arg-type]
+    """Mean E (Pa) and nu over the specimens re-bonded with ``spec`` (eq 12); ``on_test``
+    is called after each specimen's test."""
+    res = []
+    for s in specimens:
+        res.append(run_compression(s.with_spec(spec), **kw))  # type: ignore[arg-type]
+        if on_test is not None:
+            on_test()
     return (float(np.mean([r.young for r in res])), float(np.mean([r.poisson for r in res])),
             res)
 
 
 def calibrate(spec: MaterialSpec, n_specimens: int = 3, seed: int = 0, tol: float = TOLERANCE,
               max_iter: int = 12, width: float = SPECIMEN_WIDTH,
-              height: float = SPECIMEN_HEIGHT, platen_speed: float = 0.1) -> CalibrationResult:
-    """Adjust E_c and kratio of ``spec`` until E and nu are within ``tol`` of its targets."""
+              height: float = SPECIMEN_HEIGHT, platen_speed: float = 0.1,
+              on_test: Callable[[], None] | None = None) -> CalibrationResult:
+    """Adjust E_c and kratio of ``spec`` until E and nu are within ``tol`` of its targets.
+
+    ``on_test``: called after every compression test (``n_specimens`` per iteration, at
+    most ``max_iter`` iterations), e.g. to advance a progress bar."""
     if not n_specimens >= 1:
         raise ValueError(f"calibrate: n_specimens = {n_specimens!r}: must be >= 1")
     if not 0 < tol < 1:
@@ -81,7 +92,7 @@ def calibrate(spec: MaterialSpec, n_specimens: int = 3, seed: int = 0, tol: floa
     best: tuple[float, MaterialSpec, float, float, list[CompressionResult]] | None = None
     converged = False
     for it in range(1, max_iter + 1):
-        young, nu, res = measure(specimens, cur, platen_speed=platen_speed)
+        young, nu, res = measure(specimens, cur, on_test, platen_speed=platen_speed)
         e_err = (young - spec.young) / spec.young
         n_err = (nu - spec.poisson) / spec.poisson
         history.append({"iteration": it, "effective_modulus_Pa": cur.effective_modulus,

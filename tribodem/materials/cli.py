@@ -34,9 +34,12 @@ def calibrate(
     quick: bool = typer.Option(False, "--quick",
                                help=f"{QUICK_SPECIMENS} specimens instead of {FULL_SPECIMENS}."),
     seed: int = typer.Option(0, "--seed", min=0, help="First specimen seed."),
+    progress: bool = typer.Option(True, "--progress/--no-progress",
+                                  help="Progress bar (compression tests) with ETA on stderr."),
 ) -> None:
     """Calibrate E_c and kratio by uniaxial compression (seed 000 eq 12) to table 1's E, nu:
     writes summary.json, history.csv and stress_strain.png."""
+    from tribodem.io import runs
     from tribodem.materials.calibrate import TOLERANCE
     from tribodem.materials.calibrate import calibrate as run_calibration
     from tribodem.materials.compression import plot_stress_strain
@@ -47,10 +50,18 @@ def calibrate(
         raise ConfigError(f"calibrate: --material = {material!r}: must be one of "
                           f"{sorted(LIBRARY)}")
     spec = LIBRARY[key]
+    runs.check_out_dir(out, "--out")
+    runs.announce(out)
     n = QUICK_SPECIMENS if quick else FULL_SPECIMENS
-    res = run_calibration(spec, n_specimens=n, seed=seed,
-                          max_iter=QUICK_MAX_ITER if quick else FULL_MAX_ITER)
-    out.mkdir(parents=True, exist_ok=True)
+    max_iter = QUICK_MAX_ITER if quick else FULL_MAX_ITER
+    # one step per compression test; the total is the most the calibration may need
+    # (n specimens x max_iter iterations): it usually converges earlier
+    with runs.progress(n * max_iter, "test", f"calibrate {key}", enabled=progress) as bar:
+        res = run_calibration(spec, n_specimens=n, seed=seed, max_iter=max_iter,
+                              on_test=lambda: bar.update(1))
+        if hasattr(bar, "refresh"):  # converged early: end the bar where it is
+            bar.total = bar.n
+            bar.refresh()
     es = [p["E_Pa"] for p in res.per_specimen]
     ns = [p["nu"] for p in res.per_specimen]
     summary = {
