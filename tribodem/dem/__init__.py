@@ -2,7 +2,9 @@
 
 Rooms, one concept each (JAX-MD style: plain kernels over arrays, small classes that
 wire them): ``state`` (particle arrays), ``space`` (box, periodic axes),
-``neighbors`` (cell-list Verlet lists), ``contact`` (contact laws), ``walls`` (planes,
+``neighbors`` (cell-list Verlet lists), ``laws`` (contact laws as styles: one module
+each, ``laws.register`` adds one), ``contact`` (materials, pair table, the shared contact
+response and pair kernel), ``walls`` (planes, their own force pass over a near-wall list,
 servo walls), ``integrate`` (central difference with damping, time-step estimates),
 ``engine`` (``Simulation``: the step loop, checkpoints), ``recorders`` (CSV, VTK),
 ``bonds`` (linear parallel bonds, breakage log), ``thermal`` (temperature, expansion,
@@ -10,6 +12,7 @@ conduction through intact bonds), ``clumps`` (rigid multi-sphere debris bodies),
 ``trimesh`` (rigid triangle-mesh surfaces, e.g. from STL).
 """
 
+from tribodem.dem import laws
 from tribodem.dem.bonds import BondBreak, ParallelBonds, install_bonds_by_gap
 from tribodem.dem.clumps import Clumps, ClumpTemplate, debris_template, make_clumps
 from tribodem.dem.contact import Material
@@ -37,5 +40,6 @@ __all__ = [
     "TriangleSurface",
     "debris_template",
     "install_bonds_by_gap",
+    "laws",
     "make_clumps",
 ]

@@ -1,13 +1,10 @@
-"""Contact laws (LAMMPS-style "styles": one function each, one signature).
+"""Particle contacts: materials, the pair property table, and the response every law shares.
 
-- ``LINEAR`` (PFC deformability): ``kn = A / (r_i/E_i + r_j/E_j)`` -- for equal moduli
-  ``A E / (r_i + r_j)`` -- with ``A = 2 r_min t`` (2D) or ``pi r_min^2`` (3D);
-  ``ks = kn / kratio``; normal and shear dashpots by critical damping ratios beta_n, beta_s.
-- ``HERTZ`` (Hertz-Mindlin no-slip, as EDEM/LIGGGHTS): ``Fn = 4/3 E* sqrt(R*) d^1.5``,
-  ``Sn = 2 E* sqrt(R* d)``, ``St = 8 G* sqrt(R* d)``, dashpots ``gamma sqrt(S m*)`` with
-  gamma from the coefficient of restitution (``hertz_damping_from_cor``).
-Both: Coulomb friction on a shear spring carried in the contact history, constant
-directional torque (CDT) rolling friction ``mu_r Fn R*`` opposing relative rolling.
+The normal laws are styles in :mod:`tribodem.dem.laws` (``linear``: PFC deformability;
+``hertz``: Hertz-Mindlin no-slip, as EDEM/LIGGGHTS; more by ``laws.register``). Common to
+all: Coulomb friction on a shear spring carried in the contact history, constant
+directional torque (CDT) rolling friction ``mu_r Fn R*`` opposing relative rolling
+(``contact_response``), and the pair kernel ``pair_forces``.
 """
 
 from __future__ import annotations
@@ -18,16 +15,25 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit, prange
 
+from tribodem.dem import laws
 from tribodem.dem.jit import kernel
+from tribodem.dem.laws import law_normal
+from tribodem.dem.laws.table import (  # noqa: F401 - the table's columns, re-exported
+    N_PROPS,
+    P_BETAN,
+    P_BETAS,
+    P_ESTAR,
+    P_GAMMA,
+    P_GSTAR,
+    P_KRATIO,
+    P_LAW,
+    P_MU,
+    P_MUR,
+)
 from tribodem.dem.space import min_image
 
-LINEAR = 0
+LINEAR = 0  # built-in law ids (tribodem.dem.laws.BUILTIN)
 HERTZ = 1
-LAWS = {"linear": LINEAR, "hertz": HERTZ}
-
-# columns of the pair property table pairtab[mat_a, mat_b, :]
-P_LAW, P_ESTAR, P_GSTAR, P_MU, P_MUR, P_GAMMA, P_KRATIO, P_BETAN, P_BETAS = range(9)
-N_PROPS = 9
 HIST = 3  # history per contact: shear spring displacement (m), 3 components
 
 
@@ -64,7 +70,7 @@ class Material:
             ("kratio", self.kratio, self.kratio > 0, "> 0"),
             ("beta_n", self.beta_n, 0 <= self.beta_n < 1, "in [0, 1)"),
             ("beta_s", self.beta_s, 0 <= self.beta_s < 1, "in [0, 1)"),
-            ("law", self.law, self.law in LAWS, f"one of {sorted(LAWS)}"),
+            ("law", self.law, self.law in laws.ids(), f"one of {sorted(laws.ids())}"),
         ]
         for field_name, value, ok, allowed in checks:
             if not ok:
@@ -143,7 +149,7 @@ def set_pair(tab: np.ndarray, a: int, b: int, ma: Material, mb: Material, **over
     estar = 1.0 / ((1 - ma.poisson**2) / ma.young + (1 - mb.poisson**2) / mb.young)
     gstar = 1.0 / ((2 - ma.poisson) / ma.shear_modulus + (2 - mb.poisson) / mb.shear_modulus)
     row = np.zeros(N_PROPS)
-    row[P_LAW] = LAWS[ma.law]
+    row[P_LAW] = laws.ids()[ma.law]
     row[P_ESTAR] = estar
     row[P_GSTAR] = gstar
     row[P_MU] = 0.5 * (ma.friction + mb.friction)
@@ -158,33 +164,11 @@ def set_pair(tab: np.ndarray, a: int, b: int, ma: Material, mb: Material, **over
         if k == "cor":
             row[P_GAMMA] = hertz_damping_from_cor(float(v))
         elif k == "law":
-            row[P_LAW] = LAWS[str(v)]
+            row[P_LAW] = laws.ids()[str(v)]
         else:
             row[names[k]] = float(v)
     tab[a, b] = row
     tab[b, a] = row
-
-
-@njit(cache=True, inline="always")
-def law_normal(law, prop, delta, vn, rstar, mstar, lin_k):
-    """Normal force magnitude (N, + = repulsive), tangential stiffness (N/m), tangential
-    damping coefficient (N s/m), normal stiffness (N/m) and stored energy (J)."""
-    if law == HERTZ:
-        estar = prop[P_ESTAR]
-        sq = np.sqrt(rstar * delta)  # contact radius a = sqrt(R* d)
-        sn = 2.0 * estar * sq
-        st = 8.0 * prop[P_GSTAR] * sq
-        fe = (4.0 / 3.0) * estar * delta * sq
-        gm = prop[P_GAMMA] * np.sqrt(sq * mstar)  # gamma sqrt(S m*) = gm sqrt(S / a)
-        fn = fe - gm * np.sqrt(2.0 * estar) * vn
-        ct = gm * np.sqrt(8.0 * prop[P_GSTAR])
-        energy = 0.4 * fe * delta
-        return fn, st, ct, sn, energy
-    kn = lin_k
-    ks = kn / prop[P_KRATIO]
-    fn = kn * delta - 2.0 * prop[P_BETAN] * np.sqrt(mstar * kn) * vn
-    ct = 2.0 * prop[P_BETAS] * np.sqrt(mstar * ks)
-    return fn, ks, ct, kn, 0.5 * kn * delta * delta
 
 
 @njit(cache=True, inline="always")

@@ -14,7 +14,7 @@ from typing import Protocol
 
 import numpy as np
 
-from tribodem.dem import neighbors
+from tribodem.dem import laws, neighbors
 from tribodem.dem.contact import HIST, Material, pair_forces, pair_table
 from tribodem.dem.errors import SimulationUnstable, TimeStepError
 from tribodem.dem.integrate import BLOCK, advance, critical_step
@@ -235,7 +235,7 @@ class Simulation:
 
     def _pair_forces(self) -> None:
         p = self.p
-        pair_forces.pick(self.nl.n_pairs)(
+        laws.active(pair_forces).pick(self.nl.n_pairs)(
             p.pos, p.vel, p.omega, p.radius, p.mass, p.inertia, p.mat, self.nl.pair_i,
             self.nl.pair_j, self.hist, self.pairtab, self.elin, self.box.length,
             self.box.periodic, p.dim, p.thickness, self.dt, self.fpair, self.tpair_i,
@@ -249,7 +249,7 @@ class Simulation:
             return
         p = self.p
         wp, wn, wv, wm = wall_arrays(self.walls)
-        wall_forces.pick(p.n)(
+        laws.active(wall_forces).pick(p.n)(
             p.pos, p.vel, p.omega, p.radius, p.mass, p.inertia, p.mat, self._wstart,
             self._wid, wp, wn, wv, wm, self.wall_hist, self.wall_info, self._wsum,
             self.pairtab, self.elin, p.dim, p.thickness, self.dt, BLOCK, self._wforce,

@@ -15,8 +15,9 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from tribodem.dem.contact import LINEAR, P_KRATIO, P_LAW
+from tribodem.dem import laws
 from tribodem.dem.jit import kernel
+from tribodem.dem.laws.table import P_KRATIO, P_LAW
 from tribodem.dem.space import min_image
 
 BLOCK = 256  # particles per block: fixed, so block sums do not depend on the thread count
@@ -130,6 +131,8 @@ def critical_step(density: np.ndarray, radius: np.ndarray, mass: np.ndarray,
     """
     best = math.inf
     what = "no contacts"
+    # per law id: True when its step is the stiffness estimate sqrt(m/k), else Rayleigh
+    stiff_law = np.array([m.TIME_STEP == "stiffness" for m in laws.modules()])
     rr = radius
     ray_p = np.full(rr.size, np.inf)
     for m_id, m in enumerate(materials):
@@ -146,10 +149,11 @@ def critical_step(density: np.ndarray, radius: np.ndarray, mass: np.ndarray,
         rot = np.minimum(inertia[i] / (ks * rr[i] ** 2), inertia[j] / (ks * rr[j] ** 2))
         lin = np.sqrt(np.minimum(mmin / np.maximum(kn, ks), rot))
         small = np.where(rr[i] <= rr[j], i, j)
-        dtp = np.where(law == LINEAR, lin, ray_p[small])
+        stiff = stiff_law[law.astype(np.int64)]
+        dtp = np.where(stiff, lin, ray_p[small])
         p = int(np.argmin(dtp))
         best = float(dtp[p])
-        kind = "linear sqrt(m/k)" if law[p] == LINEAR else "Hertz Rayleigh (eq 2.17)"
+        kind = "stiffness sqrt(m/k)" if stiff[p] else "Rayleigh (eq 2.17)"
         what = (f"pair ({int(i[p])}, {int(j[p])}) with radii {rr[i[p]]:.4g}, "
                 f"{rr[j[p]]:.4g} m [{kind}]")
     for w in walls:
@@ -162,17 +166,18 @@ def critical_step(density: np.ndarray, radius: np.ndarray, mass: np.ndarray,
         ks = kn / pairtab[mat[near], w.material, P_KRATIO]
         lin = np.sqrt(np.minimum(mass[near] / np.maximum(kn, ks),
                                  inertia[near] / (ks * rr[near] ** 2)))
-        dtw = np.where(law == LINEAR, lin, ray_p[near])
+        stiff = stiff_law[law.astype(np.int64)]
+        dtw = np.where(stiff, lin, ray_p[near])
         q = int(np.argmin(dtw))
         if dtw[q] < best:
             best = float(dtw[q])
-            kind = "linear sqrt(m/k)" if law[q] == LINEAR else "Hertz Rayleigh (eq 2.17)"
+            kind = "stiffness sqrt(m/k)" if stiff[q] else "Rayleigh (eq 2.17)"
             what = (f"pair (particle {int(near[q])}, wall '{w.name}') with radius "
                     f"{rr[near[q]]:.4g} m [{kind}]")
-    hertz = np.flatnonzero(pairtab[mat, mat, P_LAW] != LINEAR)
-    if hertz.size:
-        s = int(hertz[np.argmin(ray_p[hertz])])
+    rayleigh = np.flatnonzero(~stiff_law[pairtab[mat, mat, P_LAW].astype(np.int64)])
+    if rayleigh.size:
+        s = int(rayleigh[np.argmin(ray_p[rayleigh])])
         if ray_p[s] < best:
             best = float(ray_p[s])
-            what = f"particle {s} (radius {rr[s]:.4g} m) [Hertz Rayleigh (eq 2.17)]"
+            what = f"particle {s} (radius {rr[s]:.4g} m) [Rayleigh (eq 2.17)]"
     return best, what

@@ -25,7 +25,7 @@ class Kernel:
     at the bottom of a settling bed.
     """
 
-    def __init__(self, fn: Callable[..., Any], chunk: int = 0) -> None:
+    def __init__(self, fn: Callable[..., Any], chunk: int = 0, cache: bool = True) -> None:
         self.py_func = fn
         self.chunk = int(chunk)
         self.__doc__ = fn.__doc__
@@ -33,8 +33,8 @@ class Kernel:
         serial_fn = types.FunctionType(fn.__code__, fn.__globals__, fn.__name__ + "_serial",
                                        fn.__defaults__, fn.__closure__)
         serial_fn.__qualname__ = fn.__qualname__ + "_serial"
-        self.serial = njit(cache=True)(serial_fn)
-        self.parallel = njit(cache=True, parallel=True)(fn)
+        self.serial = njit(cache=cache)(serial_fn)
+        self.parallel = njit(cache=cache, parallel=True)(fn)
 
     def pick(self, size: int) -> Callable[..., Any]:
         """The build to use for ``size`` items (particles or pairs)."""

@@ -25,6 +25,7 @@ import numpy as np
 from numba import prange
 from numpy.typing import NDArray
 
+from tribodem.dem import laws
 from tribodem.dem.jit import kernel
 from tribodem.dem.walls import RigidSurface, rigid_surface_contact
 
@@ -164,7 +165,7 @@ class HeightMapSurface(RigidSurface):
         if not self._contact_arrays(n) and sim.step_count > 0:
             self.update_motion(sim.dt)
         sgn = 1.0 if self.side == "below" else -1.0
-        heightmap_contacts.pick(n)(
+        laws.active(heightmap_contacts).pick(n)(
             p.pos, p.vel, p.omega, p.radius, p.mass, p.inertia, p.mat, self.heights,
             self.x0, self.y0, self.dx, self.dy, sgn, self.point, self.velocity, self.material,
             self._hist, self._touch, sim.pairtab, sim.elin, sim.dt, sim.ext_force,

@@ -34,6 +34,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numba import njit, prange
 
+from tribodem.dem import laws
 from tribodem.dem.integrate import BLOCK
 from tribodem.dem.jit import kernel
 from tribodem.dem.walls import RigidSurface, rigid_surface_contact
@@ -306,7 +307,7 @@ class TriangleSurface(RigidSurface):
         nblocks = (n + BLOCK - 1) // BLOCK
         if self._bsum.shape[0] != nblocks:
             self._bsum = np.zeros((nblocks, 5))
-        trimesh_contacts.pick(n)(
+        laws.active(trimesh_contacts).pick(n)(
             p.pos, p.vel, p.omega, p.radius, p.mass, p.inertia, p.mat, self.triangles,
             self.tri_normals, self.point, glo, 1.0 / gsize, ncell, cstart, items,
             self.velocity, self.material, self._hist, self._touch, sim.pairtab, sim.elin,
