@@ -8,14 +8,17 @@ import numpy as np
 import pytest
 
 from tribodem.cyclejump import (
+    SMOOTH_SHAPES,
     STRATEGIES,
     AdaptiveJump,
     CojocaruJump,
     ConstantJump,
     MovingGroupsJump,
     OverlappingGroupsJump,
+    error_controlled_jump,
     make_strategy,
     replay,
+    synthetic_smooth_series,
     synthetic_two_phase_series,
     transition_end,
     two_phase_rate,
@@ -341,3 +344,189 @@ def test_adaptive_total_decides_on_the_sum_of_an_array_state() -> None:
     assert jumps["total"] > 0
     with pytest.raises(ValueError, match="decide_on"):
         AdaptiveJump(decide_on="mean")
+
+
+# --- issue 13: step control follows the curve's smoothness ------------------------------
+
+SMOOTH_N = 3000
+SMOOTH_NOISE_SEEDS = range(3)
+
+
+def smooth_cases():
+    for shape in SMOOTH_SHAPES:
+        yield shape, 0.0, 0
+        for seed in SMOOTH_NOISE_SEEDS:
+            yield shape, 0.02, seed
+
+
+def test_smooth_series_forms():
+    c, inc = synthetic_smooth_series("power", n=SMOOTH_N)
+    assert c[0] == 1 and c[-1] == SMOOTH_N
+    assert np.sum(inc) == pytest.approx(SMOOTH_N**0.5)  # h = N^0.5
+    _, inc = synthetic_smooth_series("exponential", n=SMOOTH_N)
+    assert inc[0] == pytest.approx(10.0)  # r_0 = 10 r_s
+    assert inc[SMOOTH_N // 10] == pytest.approx(1 + 9 * math.exp(-1), rel=1e-3)  # N0 = n/10
+    assert inc[-1] == pytest.approx(1.0, rel=1e-3)
+    _, lin = synthetic_smooth_series("linear", n=100)
+    np.testing.assert_array_equal(lin, np.ones(100))
+    np.testing.assert_array_equal(synthetic_smooth_series("two_phase", n=2000, noise=0.02,
+                                                          seed=3)[1],
+                                  synthetic_two_phase_series(noise=0.02, seed=3)[1])
+    _, noisy = synthetic_smooth_series("linear", n=SMOOTH_N, noise=0.02, seed=1)
+    assert 0.018 < np.std(noisy) < 0.022
+    with pytest.raises(ValueError, match="allowed"):
+        synthetic_smooth_series("cubic")
+
+
+def test_error_controlled_jump_formula():
+    # relative error of the extrapolated increment = rate_error + kappa (lag + L / 2)
+    assert error_controlled_jump(0.0, 0.01) == math.inf
+    assert error_controlled_jump(0.01, 0.01) == pytest.approx(2.0)
+    assert error_controlled_jump(1e-4, 0.01, lag=3.5) == pytest.approx(193.0)
+    assert error_controlled_jump(1e-4, 0.01, rate_error=0.004) == pytest.approx(120.0)
+    assert error_controlled_jump(1e-4, 0.01, rate_error=0.01) == 0.0
+    assert error_controlled_jump(0.01, 0.01, lag=5.0) == 0.0
+    assert error_controlled_jump(math.inf, 0.01) == 0.0
+
+
+@pytest.mark.parametrize("shape, noise, seed", list(smooth_cases()))
+def test_adaptive_default_saves_60_percent_on_smooth_shapes(shape, noise, seed):
+    """Acceptance (issue 13 item 6): >= 60 % saved at <= 5 % final error on every shape."""
+    c, inc = synthetic_smooth_series(shape, n=SMOOTH_N, noise=noise, seed=seed)
+    r = replay(AdaptiveJump(), c, inc)
+    assert r.cycles_saved_fraction >= 0.60, r.summary()
+    assert r.relative_difference <= 0.05, r.summary()
+    if noise == 0.0:
+        # the error control keeps every jump within tol = 1 % of what it adds
+        assert r.relative_difference <= 0.01, r.summary()
+    if shape == "linear" and noise == 0.0:
+        assert r.relative_difference <= 1e-9
+
+
+def test_seed_linearity_gate_is_blind_on_a_power_law():
+    """The problem the step control fixes: kappa <= q_y refuses a smoothly bending curve."""
+    c, inc = synthetic_smooth_series("power", n=1000)
+    seed = replay(AdaptiveJump(step_control="seed"), c, inc)
+    error = replay(AdaptiveJump(), c, inc)
+    assert seed.cycles_saved_fraction < 0.1
+    assert error.cycles_saved_fraction > 6 * seed.cycles_saved_fraction
+
+
+@pytest.mark.parametrize("tol", [0.005, 0.02, 0.05])
+def test_adaptive_tolerance_bounds_the_final_error(tol):
+    """tol is the relative local error per jump, so it bounds the final relative error on
+    noise-free smooth shapes; a looser tolerance saves more."""
+    for shape in ("power", "exponential", "two_phase"):
+        c, inc = synthetic_smooth_series(shape, n=SMOOTH_N)
+        r = replay(AdaptiveJump(tol=tol), c, inc)
+        assert r.relative_difference <= tol, (shape, r.summary())
+        assert r.max_relative_difference <= tol, (shape, r.summary())
+        if tol > 0.01:
+            assert r.cycles_saved_fraction > replay(AdaptiveJump(), c, inc).cycles_saved_fraction
+
+
+@pytest.mark.parametrize("name, params", [
+    ("constant", {"step_control": "error"}),
+    ("cojocaru", {}),
+    ("moving", {}),
+    ("overlapping", {}),
+    ("cojocaru", {"q_e": 0.02}),
+    ("moving", {"q_e": 0.02}),
+    ("overlapping", {"q_e": 0.02}),
+])
+def test_error_controlled_strategies_stay_within_their_tolerance(name, params):
+    s = make_strategy(name, **params)
+    tol = s.tol if name == "constant" else s.tolerance
+    for shape in ("power", "exponential", "two_phase"):
+        c, inc = synthetic_smooth_series(shape, n=SMOOTH_N)
+        r = replay(make_strategy(name, **params), c, inc)
+        assert r.relative_difference <= tol, (shape, r.summary())
+
+
+def test_constant_error_control_shortens_jumps_where_the_curve_bends():
+    c, inc = synthetic_smooth_series("two_phase", n=2000)
+    blind = replay(ConstantJump(), c, inc)
+    ctrl = replay(ConstantJump(step_control="error"), c, inc)
+    assert blind.relative_difference > 0.02  # McColl over-predicts during running-in
+    assert ctrl.relative_difference < 0.01 * 0.1 and ctrl.cycles_saved_fraction > 0.8
+    # short jumps while the rate still bends, N - 1 (the longest allowed) once it is steady
+    assert all(n < 19 for s, n in ctrl.jumps if s < 2 * transition_end())
+    assert all(n == 19 for s, n in ctrl.jumps[:-1] if s > 1000)  # the last one is clipped
+
+
+def test_cojocaru_error_cap_stops_noise_driven_long_jumps():
+    """A ratio that is small by chance gives dx = q_e / |r| without bound (section 4.2.2);
+    the measured curvature caps it."""
+    c, inc = synthetic_smooth_series("power", n=SMOOTH_N, noise=0.02, seed=0)
+    seed = replay(CojocaruJump(step_control="seed"), c, inc)
+    ctrl = replay(CojocaruJump(), c, inc)
+    assert ctrl.max_relative_difference < seed.max_relative_difference / 3
+    assert ctrl.relative_difference <= CojocaruJump().tolerance
+
+
+def test_measured_curvature_ignores_jumped_points():
+    # w = n + 1e-3 n^2: measured rates 1 + 1e-3 (2n - 1), kappa = 2e-3 / rate
+    s = AdaptiveJump()
+    for n in range(0, 41):
+        s.observe(n, n + 1e-3 * n * n)
+    k = s.measured_curvature(window_fraction=None, both_ends=False)
+    assert k == pytest.approx(2e-3 / (1 + 1e-3 * 79))
+    s.extrapolate(40 + 1.6, 30)  # a straight extrapolation must not straighten the curve
+    assert s.measured_curvature(window_fraction=None, both_ends=False) == k
+    assert ConstantJump().measured_curvature() != ConstantJump().measured_curvature()  # nan
+
+
+def test_adaptive_total_on_a_profile_of_smooth_shapes():
+    """decide_on="total" (the fretting loop's setting) on a profile whose elements follow
+    different smooth laws."""
+    cols = [synthetic_smooth_series(sh, n=SMOOTH_N, noise=0.02, seed=k)[1]
+            for k, sh in enumerate(SMOOTH_SHAPES)]
+    inc = np.column_stack(cols) * np.array([1.0, 20.0, 0.5, 1.0])
+    c = np.arange(1, SMOOTH_N + 1, dtype=float)
+    r = replay(AdaptiveJump(decide_on="total"), c, inc)
+    assert r.cycles_saved_fraction >= 0.6, r.summary()
+    assert r.relative_difference <= 0.05, r.summary()
+    total = replay(AdaptiveJump(), c, inc.sum(axis=1))
+    assert abs(np.sum(r.final_value) - total.reference_final_value) <= \
+        0.05 * total.reference_final_value
+
+
+def test_strategies_pickle_mid_run_and_continue_identically():
+    """A strategy pickled mid-run (state save/restore) continues exactly like the original."""
+    import pickle
+
+    c, inc = synthetic_smooth_series("exponential", n=600, noise=0.02, seed=2)
+    for name in STRATEGIES:
+        a = make_strategy(name)
+        a.observe(0, 0.0)
+        copies: list = []
+        h, i = 0.0, 0
+        while i < len(c):
+            h += inc[i]
+            if i >= 300 and not copies:
+                copies.append(pickle.loads(pickle.dumps(a)))
+            props = []
+            for s in [a, *copies]:
+                s.observe(int(c[i]), h)
+                props.append(min(s.propose_jump(), len(c) - 1 - i))
+            assert len(set(props)) == 1, (name, i, props)
+            if props[0]:
+                new = [s.extrapolate(h, props[0]) for s in [a, *copies]]
+                assert len(set(new)) == 1, (name, i, new)
+                h, i = new[0], i + props[0]
+            i += 1
+        assert copies and copies[0].jumps == a.jumps
+
+
+def test_step_control_parameters_are_checked():
+    for cls in (AdaptiveJump, CojocaruJump, MovingGroupsJump, OverlappingGroupsJump,
+                ConstantJump):
+        with pytest.raises(ValueError, match="step_control"):
+            cls(step_control="ode")
+        with pytest.raises(ValueError, match="tol"):
+            cls(tol=0.0)
+    with pytest.raises(ValueError, match="min_jump"):
+        AdaptiveJump(min_jump=0)
+    assert AdaptiveJump().tolerance == 0.01 and AdaptiveJump(q_e=0.04).tolerance == 0.02
+    assert AdaptiveJump(tol=0.003).tolerance == 0.003
+    assert CojocaruJump().tolerance == 0.025 and MovingGroupsJump().tolerance == 0.0005

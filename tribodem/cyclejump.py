@@ -24,7 +24,14 @@ its own fitted rate. Protocol::
 
 :func:`replay` runs that loop on a recorded series of per-cycle increments (appendix III
 reads ``Result.csv``), and :func:`synthetic_two_phase_series` makes a running-in + steady
-test series (seed figure 5.17).
+test series (seed figure 5.17); :func:`synthetic_smooth_series` makes linear, power-law,
+exponential run-in and two-phase series.
+
+Step control (issue 13): every strategy but ``constant`` (opt-in there) bounds its jump
+with :func:`error_controlled_jump`, the longest jump whose predicted local error stays
+within a relative tolerance ``tol`` of the extrapolated increment, using the curvature of
+the rates measured on simulated cycles (never on extrapolated ones). ``step_control=
+"seed"`` restores each strategy's rule as the seed states it.
 """
 
 from __future__ import annotations
@@ -60,6 +67,37 @@ def _active(rate: NDArray[np.float64]) -> NDArray[np.bool_]:
     return np.abs(rate) >= ACTIVE_FRACTION * m
 
 
+def error_controlled_jump(kappa: float, tol: float, lag: float = 0.0,
+                          rate_error: float = 0.0) -> float:
+    """Longest jump (cycles, not rounded) whose local error stays within ``tol``.
+
+    A jump of L cycles extrapolates with a constant rate that was estimated ``lag`` cycles
+    before the jump starts. If the rate changes by the relative amount ``kappa`` per cycle
+    (kappa = |f''| / |f'|, 1/cycle), the extrapolated increment misses
+
+        error = |f''| (lag L + L**2 / 2)        (difference of the linear and quadratic
+                                                  predictors over the jump)
+
+    and its ratio to the extrapolated increment |f'| L is kappa (lag + L / 2). Keeping
+    that ratio <= ``tol`` gives L = 2 (tol / kappa - lag); ``inf`` for kappa = 0 and 0 when
+    the lag alone uses the tolerance. Because every jump misses at most ``tol`` of what it
+    adds, the cumulative value misses at most ``tol`` of its jumped part.
+    """
+    if not math.isfinite(kappa) or not rate_error < tol:
+        return 0.0
+    if kappa <= 0.0:
+        return math.inf
+    return max(0.0, 2.0 * ((tol - rate_error) / kappa - lag))
+
+
+def _check_step_control(step_control: str, tol: float | None) -> None:
+    if step_control not in ("error", "seed"):
+        raise ValueError(f"step_control = {step_control!r}: must be 'error' (jump length "
+                         "capped by the local error estimate) or 'seed' (the seed's rule alone)")
+    if tol is not None and not (math.isfinite(tol) and tol > 0):
+        raise ValueError("tol must be a finite number > 0 (relative local error per jump)")
+
+
 def _restore(template: State, arr: NDArray[np.float64]) -> State:
     if np.ndim(template) == 0:
         return float(arr.reshape(-1)[0])
@@ -83,6 +121,13 @@ class JumpStrategy(ABC):
         self._cycles: list[float] = []
         self._states: list[NDArray[np.float64]] = []
         self._shape: tuple[int, ...] | None = None
+        self._first_cycle = math.nan  # first observed cycle (the slope-ratio family drops
+        # its history after a jump; the rate log below is kept)
+        # measured rates (increment of a simulated cycle whose predecessor was observed
+        # one cycle earlier), kept across jumps and window restarts: (mid-cycle, rate)
+        self._rate_cycles = np.empty(0)
+        self._rates = np.empty((0, 0))
+        self._n_rates = 0
         self.jumps: list[tuple[int, int]] = []  # (cycle the jump starts from, length)
 
     @property
@@ -96,9 +141,81 @@ class JumpStrategy(ABC):
             raise ValueError(f"cycle {cycle} is not after the last one ({self._cycles[-1]})")
         if self._shape is None:
             self._shape = np.shape(value)
+        new = _as_2d(value)
+        if not self._cycles and not self._n_rates:
+            self._first_cycle = float(cycle)
+        if self._cycles and cycle == self._cycles[-1] + 1:
+            self._log_rate(cycle - 0.5, new - self._states[-1])
         self._cycles.append(float(cycle))
-        self._states.append(_as_2d(value))
+        self._states.append(new)
         self._after_observe(jumped=False)
+
+    def _log_rate(self, mid: float, rate: NDArray[np.float64]) -> None:
+        n = self._n_rates
+        if n == len(self._rate_cycles):  # grow the buffers (amortised O(1) per rate)
+            cap = max(64, 2 * n)
+            xs, ys = np.empty(cap), np.empty((cap, rate.size))
+            if n:
+                xs[:n], ys[:n] = self._rate_cycles[:n], self._rates[:n]
+            self._rate_cycles, self._rates = xs, ys
+        self._rate_cycles[n] = mid
+        self._rates[n] = rate
+        self._n_rates = n + 1
+
+    def _rate_rows(self, since: float, min_samples: int, act: NDArray[np.bool_] | None,
+                   total: bool) -> tuple[NDArray[np.float64], NDArray[np.float64]] | None:
+        """Measured rates after cycle ``since`` (at least the newest ``min_samples``):
+        (mid-cycles, rates (n, elements)); ``act`` selects elements, ``total`` sums them.
+
+        A measured rate is the recorded increment of a simulated cycle whose predecessor
+        was observed one cycle earlier. Extrapolated spans never contribute, so a jump
+        cannot make the curve look straighter than it is, and the log survives jumps and
+        window restarts. ``None`` with fewer than ``max(min_samples, 3)`` rates.
+        """
+        n, m = self._n_rates, max(min_samples, 3)
+        if n < m:
+            return None
+        tm = self._rate_cycles[:n]
+        k = max(0, min(int(np.searchsorted(tm, since)), n - m))
+        r = self._rates[k:n]
+        if act is not None:
+            r = r[:, act]
+        if total:
+            r = r.sum(axis=1, keepdims=True)
+        if r.shape[1] == 0:
+            return None
+        return tm[k:], r
+
+    def measured_curvature(self, act: NDArray[np.bool_] | None = None,
+                           window_fraction: float | None = 0.5, min_samples: int = 3,
+                           both_ends: bool = True, total: bool = False) -> float:
+        """Relative curvature kappa = |f''| / |f'| (1/cycle) of the measured rates.
+
+        A least-squares line is fitted to the measured rates (see :meth:`_rate_rows`) of
+        the newest ``window_fraction`` of the history (all of it for ``None``); its slope
+        is f'' and f' is its value at the newest rate (and at the oldest with
+        ``both_ends``: the larger kappa counts). The worst element counts. ``nan``
+        without an estimate (too few rates), ``inf`` where the rate is 0.
+        """
+        since = -math.inf
+        if window_fraction is not None and self._cycles:
+            since = self._cycles[-1] - window_fraction * (self._cycles[-1] - self._first_cycle)
+        rows = self._rate_rows(since, min_samples, act, total)
+        if rows is None:
+            return math.nan
+        tm, r = rows
+        x = tm - tm[-1]
+        xm = x.mean()
+        rm = r.mean(axis=0)
+        slope = ((x - xm) @ (r - rm)) / float((x - xm) @ (x - xm))
+        level = rm - slope * xm  # the line at the newest rate
+        kap = 0.0
+        for e in ([0.0, float(x[0])] if both_ends else [0.0]):
+            f1 = np.abs(level + slope * e)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                kk = np.where(f1 > 0, np.abs(slope) / f1, np.where(slope == 0, 0.0, np.inf))
+            kap = max(kap, float(np.max(kk)))
+        return kap
 
     def _after_observe(self, jumped: bool) -> None:  # noqa: B027 - optional hook
         """Hook for strategies that update fits on every new point."""
@@ -139,14 +256,26 @@ class ConstantJump(JumpStrategy):
     After every simulated cycle, jump ``jump_length - 1`` cycles assuming the wear rate of
     that cycle stays constant: H_total = N * H^N. Default N = 20 (section 4.2.1; McColl
     et al. used 30).
+
+    The rule is blind to curvature. ``step_control="error"`` (opt-in; the default
+    ``"seed"`` keeps eq 2.20, whose over-prediction during running-in is the seed's point)
+    keeps the extrapolation with the newest cycle's rate but shortens the jump to
+    :func:`error_controlled_jump` (relative local error per jump <= ``tol``, default 1 %;
+    the rate is half a cycle old, lag 0.5), with the curvature measured on the rates of
+    the simulated cycles of the newest half of the run (:meth:`measured_curvature`);
+    ``jump_length - 1`` stays the longest jump. No jump before 3 rates are measured.
     """
 
     name = "constant"
 
-    def __init__(self, jump_length: int = 20) -> None:
+    def __init__(self, jump_length: int = 20, step_control: str = "seed",
+                 tol: float = 0.01) -> None:
         if jump_length < 1:
             raise ValueError("jump_length must be >= 1")
+        _check_step_control(step_control, tol)
         self.jump_length = int(jump_length)
+        self.step_control = step_control
+        self.tol = float(tol)
         super().__init__()
 
     @property
@@ -159,7 +288,14 @@ class ConstantJump(JumpStrategy):
     def propose_jump(self) -> int:
         if len(self._cycles) < 2:
             return 0
-        return self.jump_length - 1
+        if self.step_control == "seed":
+            return self.jump_length - 1
+        # error control: the rate of the newest cycle is the rate half a cycle back (lag 0.5)
+        kap = self.measured_curvature()
+        if math.isnan(kap):  # fewer than 3 measured rates: no evidence of the curvature yet
+            return 0
+        dx = error_controlled_jump(kap, self.tol, lag=0.5)
+        return int(min(dx, self.jump_length - 1))
 
     def _increment(self, n: int) -> NDArray[np.float64]:
         return n * self._rate()
@@ -178,12 +314,40 @@ class _SlopeRatioJump(JumpStrategy):
     newest slope: state + dx * s2 (section 4.5). Groups never span a jump: after a jump
     the history restarts at the jumped-to point, so each jump needs fresh evidence.
     For an array state the worst element (largest |r|) decides.
+
+    Step control (``step_control="error"``, the default): the ratio sees the curvature
+    inside its groups only, and a ratio that is small by chance (noise, an inflection)
+    gives an arbitrarily long jump. The jump is therefore also capped by
+    :func:`error_controlled_jump`: relative local error per jump <= ``tol`` (default
+    q_e / 2, the seed's own tolerance: q_e is the relative change of the rate over the jump,
+    twice the relative error of the extrapolated increment), with the curvature measured on
+    the rates of the simulated cycles of the newest half of the run, across jumps
+    (:meth:`measured_curvature`), and the lag (x - 1) / 2 between the newest group's centre,
+    where s2 is the rate, and the newest point. ``step_control="seed"``: eqs 4.2/4.4/4.6
+    alone.
     """
 
     group_size: int
     q_y: float
     q_e: float
     max_jump: int | None
+    step_control: str = "error"
+    tol: float | None = None
+
+    def _set_step_control(self, step_control: str, tol: float | None) -> None:
+        _check_step_control(step_control, tol)
+        self.step_control = step_control
+        self.tol = None if tol is None else float(tol)
+
+    @property
+    def tolerance(self) -> float:
+        """Relative local error per jump: ``tol``, or q_e / 2 when ``tol`` is None."""
+        return self.q_e / 2 if self.tol is None else self.tol
+
+    def _lag(self) -> float:
+        """Cycles between the newest group's centre (where its slope is the rate) and the
+        newest point."""
+        return (self.group_size - 1) / 2
 
     def _groups(self) -> tuple[slice, slice]:
         raise NotImplementedError
@@ -230,6 +394,12 @@ class _SlopeRatioJump(JumpStrategy):
         n = 0
         if math.isfinite(r) and r <= self.q_y:
             dx = math.inf if r == 0 else self.q_e * self._spacing() / r
+            if self.step_control == "error":
+                # the ratio sees the curvature inside its groups only; the rates measured
+                # over the newest half of the run (across jumps) cap the jump too
+                kap = self.measured_curvature(_active(self._slope(self._groups()[1])))
+                if not math.isnan(kap):
+                    dx = min(dx, error_controlled_jump(kap, self.tolerance, self._lag()))
             if self.max_jump is not None:
                 dx = min(dx, self.max_jump)
             n = int(min(dx, UNBOUNDED_JUMP))
@@ -246,16 +416,20 @@ class CojocaruJump(_SlopeRatioJump):
 
     r = (s_(n+1 to n+2) - s_(n to n+1)) / s_(n to n+1); jump if |r| <= q_y, by
     dx = floor(q_e / |r|) cycles. Defaults q_y = 0.02, q_e = 0.05 (section 4.2.2).
-    ``max_jump`` (cycles, default none) caps dx; the seed sets no cap.
+    ``max_jump`` (cycles, default none) caps dx; the seed sets no cap. ``step_control``,
+    ``tol``: the error-controlled cap of :class:`_SlopeRatioJump` (default on, tol = q_e / 2
+    = 2.5 %).
     """
 
     name = "cojocaru"
 
-    def __init__(self, q_y: float = 0.02, q_e: float = 0.05, max_jump: int | None = None) -> None:
+    def __init__(self, q_y: float = 0.02, q_e: float = 0.05, max_jump: int | None = None,
+                 step_control: str = "error", tol: float | None = None) -> None:
         self.group_size = 2
         self.q_y = float(q_y)
         self.q_e = float(q_e)
         self.max_jump = None if max_jump is None else int(max_jump)
+        self._set_step_control(step_control, tol)
         super().__init__()
 
     def _span_needed(self) -> int:
@@ -274,7 +448,8 @@ class _GroupsJump(_SlopeRatioJump):
     even_groups = False
 
     def __init__(self, group_size: int = 8, q_y: float = 1.0, q_e: float = 0.001,
-                 max_jump: int | None = None) -> None:
+                 max_jump: int | None = None, step_control: str = "error",
+                 tol: float | None = None) -> None:
         if group_size < 2 or (self.even_groups and group_size % 2):
             kind = "an even number" if self.even_groups else "a whole number"
             raise ValueError(f"group_size must be {kind} >= 2")
@@ -282,6 +457,7 @@ class _GroupsJump(_SlopeRatioJump):
         self.q_y = float(q_y)
         self.q_e = float(q_e)
         self.max_jump = None if max_jump is None else int(max_jump)
+        self._set_step_control(step_control, tol)
         super().__init__()
 
 
@@ -291,6 +467,8 @@ class MovingGroupsJump(_GroupsJump):
     Two abutting groups of x points: r = (s_(n+x to n+2x) - s_(n to n+x)) / s_(n to n+x);
     group centres are x cycles apart, dx = floor(q_e * x / |r|). Defaults x = 8,
     q_y = 1, q_e = 0.1 % (table 4.1, the column in which the seed saw jumps).
+    ``step_control``, ``tol``: the error-controlled cap of :class:`_SlopeRatioJump`
+    (default on, tol = q_e / 2 = 0.05 %; lag 3.5 cycles for x = 8).
     """
 
     name = "moving"
@@ -311,6 +489,8 @@ class OverlappingGroupsJump(_GroupsJump):
 
     Groups (n .. n+x) and (n+x/2 .. n+1.5x) share x/2 points; centres are x/2 cycles
     apart, dx = floor(q_e * (x/2) / |r|). Defaults x = 8, q_y = 1, q_e = 0.1 % (table 4.2).
+    ``step_control``, ``tol``: the error-controlled cap of :class:`_SlopeRatioJump`
+    (default on, tol = q_e / 2 = 0.05 %; lag 3.5 cycles for x = 8).
     """
 
     name = "overlapping"
@@ -387,6 +567,34 @@ class AdaptiveJump(JumpStrategy):
     Decision: the fretting loop uses ``"total"``: on a grid, a point the growing scar reaches
     starts wearing with a kink, so single points never look polynomial, while the worn
     volume does (the fit is linear in the data: the sum's fit is the sum of the fits).
+
+    Step control (``step_control="error"``, the default). Steps 1 and 4 are kept; steps 2
+    and 3 become an error-controlled jump, as in an ODE integrator. The seed's linearity
+    gate kappa <= q_y refuses every jump on a curve that bends, however smoothly (a power
+    law or a slow run-in), instead of shortening the jump; and the polynomial, which
+    contains the jumped-to points (its own straight extrapolations), can look straighter
+    than the wear is. So:
+
+    2'. kappa is the larger of the polynomial's (as above) and the one measured on the
+        rates of the simulated cycles of the newest ``window_fraction`` of the run
+        (:meth:`measured_curvature`; no jumped point enters it);
+    2''. the extrapolation rate f'(t_end) is checked against the measured rates
+        (:meth:`rate_mismatch`): its relative error e_r beyond two standard errors uses up
+        part of the tolerance; if e_r >= tol the polynomial no longer follows the wear and,
+        with ``moving_window``, the window restarts (modification d) at the present cycle;
+    3'. dx = floor(2 (tol - e_r) / kappa) (:func:`error_controlled_jump`): the longest jump
+        whose predicted error (truncation 0.5 |f''| dx^2, the difference of the linear and
+        quadratic predictors, plus e_r |f'| dx) stays within ``tol`` of the extrapolated
+        increment |f'| dx, capped by modification a; no jump shorter than ``min_jump``.
+
+    ``tol`` (default None = q_e / 2 = 1 %): relative local error per jump. Since every jump
+    misses at most ``tol`` of what it adds, the final value misses at most ``tol`` of its
+    jumped part (noise adds a random part). With e_r = 0 this is the seed's
+    dx = q_e / kappa (eq 4.13'). ``min_jump`` (4 cycles) = q_e / q_y, the shortest jump the
+    seed's early linearity gate allowed (it keeps jumps out of a fast running-in).
+    ``q_y``, ``q_y_late``, ``q_y_until`` are used by ``step_control="seed"`` only (the
+    seed's version, steps 1-4 unchanged). With ``taylor_order=2`` the same (first-order)
+    error estimate is used, which is then conservative.
     """
 
     name = "adaptive"
@@ -411,7 +619,16 @@ class AdaptiveJump(JumpStrategy):
         curvature_over_window: bool = True,
         taylor_order: int = 1,
         decide_on: str = "worst",
+        step_control: str = "error",
+        tol: float | None = None,
+        min_jump: int = 4,
     ) -> None:
+        _check_step_control(step_control, tol)
+        if min_jump < 1:
+            raise ValueError("min_jump must be >= 1")
+        self.step_control = step_control
+        self.tol = None if tol is None else float(tol)
+        self.min_jump = int(min_jump)
         if decide_on not in ("worst", "total"):
             raise ValueError(f"decide_on = {decide_on!r}: must be 'worst' (every element) or "
                              "'total' (the sum of the state, e.g. the worn volume)")
@@ -458,6 +675,11 @@ class AdaptiveJump(JumpStrategy):
     @property
     def foundation(self) -> int:
         return self.foundation_cycles
+
+    @property
+    def tolerance(self) -> float:
+        """Relative local error per jump: ``tol``, or q_e / 2 when ``tol`` is None."""
+        return self.q_e / 2 if self.tol is None else self.tol
 
     def max_jump(self, cycle: float) -> int:
         """Section 4.4 (a): maximum jump length at ``cycle``."""
@@ -533,6 +755,38 @@ class AdaptiveJump(JumpStrategy):
         denom = np.where(denom > 0, denom, np.inf)
         return float(np.max(np.abs(c - prev) / denom))
 
+    def rate_mismatch(self, act: NDArray[np.bool_], cycle: float) -> float:
+        """Relative error of the extrapolation rate f'(t_end) of the polynomial, judged
+        against the measured rates (0 when within two standard errors; ``inf`` without
+        enough measured rates).
+
+        A quadratic is fitted to the measured rates of the fit window (at least
+        ``foundation_cycles`` of them) and evaluated at ``cycle``: an independent estimate
+        of the present rate, which sees no jumped point. The mismatch is
+        (|f'(t_end) - rate| - 2 se) / |rate|, se = standard error of that estimate; the
+        worst element counts (the total with ``decide_on="total"``).
+        """
+        total = self.decide_on == "total"
+        t, _ = self._window()
+        rows = self._rate_rows(t[0] + self._cycles[self._n0], self.foundation_cycles, act,
+                               total)
+        if rows is None:
+            return math.inf
+        tm, r = rows
+        x = (tm - cycle) / max(cycle - tm[0], 1.0)
+        v = np.vander(x, 3)
+        coef, *_ = np.linalg.lstsq(v, r, rcond=None)
+        sigma = np.sqrt(np.sum((r - v @ coef) ** 2, axis=0) / max(len(x) - 3, 1))
+        se = sigma * math.sqrt(float(np.linalg.pinv(v.T @ v)[-1, -1]))
+        meas = coef[-1]
+        d1 = self._derivs(float(t[-1]))[0][act]
+        if total:
+            d1 = np.array([d1.sum()])
+        with np.errstate(divide="ignore", invalid="ignore"):
+            mis = (np.abs(d1 - meas) - 2.0 * se) / np.abs(meas)
+        mis = np.where(np.isfinite(mis), mis, np.inf)
+        return max(0.0, float(np.max(mis)))
+
     def _restart_window(self) -> None:
         self._n0 = len(self._cycles) - 1
         self._coef = None
@@ -557,7 +811,7 @@ class AdaptiveJump(JumpStrategy):
             t, y = self._window()
             t_end = float(t[-1])
             d1, d2 = self._derivs(t_end)
-            act = _active(d1)
+            act = act_el = _active(d1)
             if np.any(act):
                 rise = np.polyval(self._coef, t_end) - np.polyval(self._coef, float(t[0]))
                 d1s, d2s = self._derivs(float(t[0]))
@@ -570,9 +824,24 @@ class AdaptiveJump(JumpStrategy):
                 if self.curvature_over_window:
                     d2 = np.maximum(np.abs(d2), np.abs(d2s))
                 curv = float(np.max(np.abs(d2[act]) / np.abs(d1[act])))
-                if qc <= self.q_coef and curv <= self.q_y_at(cycle):
-                    dx = math.inf if curv == 0 else self.q_e / curv
+                if self.step_control == "seed":
+                    if qc <= self.q_coef and curv <= self.q_y_at(cycle):
+                        dx = math.inf if curv == 0 else self.q_e / curv
+                        proposal = int(min(dx, self.max_jump(cycle), UNBOUNDED_JUMP))
+                elif qc <= self.q_coef:
+                    kap = self.measured_curvature(
+                        act_el, self.window_fraction, self.foundation_cycles,
+                        self.curvature_over_window, self.decide_on == "total")
+                    rate_err = self.rate_mismatch(act_el, cycle)
+                    curv = max(curv, math.inf if math.isnan(kap) else kap)
+                    dx = error_controlled_jump(curv, self.tolerance, rate_error=rate_err)
                     proposal = int(min(dx, self.max_jump(cycle), UNBOUNDED_JUMP))
+                    if proposal < self.min_jump:
+                        proposal = 0
+                    if rate_err >= self.tolerance and self.moving_window and \
+                            len(self._cycles) - self._n0 > 2 * self.foundation_cycles:
+                        # the polynomial no longer follows the measured rate: drop it
+                        self._restart_window()
         if proposal == 0:
             self._consecutive = 0
         d = self.diagnostics
@@ -746,3 +1015,44 @@ def transition_end(ratio: float = 10.0, tau: float = 50.0, factor: float = 1.5) 
     if ratio <= factor:
         return 0.0
     return 1.0 + tau * math.log((ratio - 1.0) / (factor - 1.0))
+
+
+#: Shapes of :func:`synthetic_smooth_series`.
+SMOOTH_SHAPES = ("linear", "power", "exponential", "two_phase")
+
+
+def synthetic_smooth_series(
+    shape: str, n: int = 3000, noise: float = 0.0, seed: int = 0, steady_rate: float = 1.0,
+    ratio: float = 10.0, exponent: float = 0.5, decay: float | None = None,
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Smooth wear series for step-control tests: ``(cycles, increments)``, c = 1..n.
+
+    The noise-free rate (per cycle, units of ``steady_rate``) is
+
+    * ``linear``: steady_rate;
+    * ``power``: the increments of h(c) = steady_rate c**exponent (h ~ N**0.5: wear that
+      slows down for ever, e.g. growing contact area);
+    * ``exponential``: steady_rate (1 + (ratio - 1) exp(-(c - 1) / decay)), a run-in that
+      starts ``ratio`` (10) times faster than steady and decays over ``decay`` cycles
+      (default n / 10: a slow run-in over the first third of the run);
+    * ``two_phase``: :func:`synthetic_two_phase_series` (the same law with tau = 50: a fast
+      run-in, then steady).
+
+    Each increment is multiplied by (1 + noise z), z ~ N(0, 1) i.i.d. from
+    ``numpy.random.default_rng(seed)``, as in :func:`synthetic_two_phase_series`.
+    """
+    if shape not in SMOOTH_SHAPES:
+        raise ValueError(f"unknown shape {shape!r}; allowed: {', '.join(SMOOTH_SHAPES)}")
+    if shape == "two_phase":
+        return synthetic_two_phase_series(n=n, ratio=ratio, noise=noise, seed=seed,
+                                          steady_rate=steady_rate)
+    c = np.arange(1, n + 1, dtype=float)
+    if shape == "linear":
+        rate = np.full(n, float(steady_rate))
+    elif shape == "power":
+        rate = steady_rate * (c**exponent - (c - 1.0) ** exponent)
+    else:
+        tau = n / 10.0 if decay is None else float(decay)
+        rate = two_phase_rate(c, steady_rate, ratio, tau)
+    z = np.random.default_rng(seed).standard_normal(n)
+    return c, rate * (1.0 + noise * z)
