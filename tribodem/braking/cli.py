@@ -390,8 +390,6 @@ def braking_sweep(
 
     base = _config(None, config, quick).model_dump()
     base["condition"] = {}
-    runs.check_out_dir(out, "--out")
-    runs.announce(out)
     seed0 = int(base["geometry"]["seed"])
     t0 = time.perf_counter()
     members: list[tuple[int, int, dict[str, Any], Path]] = []
@@ -401,6 +399,8 @@ def braking_sweep(
             setup_from_config(validate(BrakingConfig, data, source="sweep"))
             d = out / f"condition_{k}" if seeds == 1 else out / f"condition_{k}" / f"seed_{s}"
             members.append((k, s, data, d))
+    runs.check_out_dir(out, "--out")  # every member checked first: no folder for a bad one
+    runs.announce(out)
     results: dict[tuple[int, int], dict[str, Any]] = {}
     failed: dict[tuple[int, int], str] = {}
     todo = []
