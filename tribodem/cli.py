@@ -88,9 +88,20 @@ def main() -> None:
     """
     from tribodem.io import runs
 
+    def interrupted() -> None:
+        where = runs.where()
+        typer.echo("\ninterrupted (Ctrl-C)" + (f": {where}" if where else ""), err=True)
+        sys.exit(130)
+
     try:
         _register(sys.argv[1:])
-        app(standalone_mode=False)
+        # without standalone mode typer *returns* the code of an Exit it caught, and turns
+        # Ctrl-C into Exit(130): map both here
+        rv = app(standalone_mode=False)
+        if rv == 130:
+            interrupted()
+        if isinstance(rv, int) and not isinstance(rv, bool) and rv:
+            sys.exit(rv)
     except ConfigError as err:
         typer.echo(f"error: {err}", err=True)
         sys.exit(2)
@@ -101,9 +112,7 @@ def main() -> None:
             typer.echo(where, err=True)
         sys.exit(3)
     except (KeyboardInterrupt, typer.Abort):
-        where = runs.where()
-        typer.echo("\ninterrupted (Ctrl-C)" + (f": {where}" if where else ""), err=True)
-        sys.exit(130)
+        interrupted()
     except typer.Exit as e:
         sys.exit(e.exit_code)
     except TyperException as err:  # typer/click usage errors: its own short message
