@@ -9,6 +9,15 @@ Prints a markdown table: cycles saved, final and maximum relative difference, an
 of runs with a jump inside the running-in transition (true rate > 1.5x steady).
 
     .venv/bin/python benchmarks/cyclejump_replay.py [--seeds 10]
+
+``--smooth`` (issue 13, step control): every strategy on the smooth shapes of
+``tribodem.cyclejump.synthetic_smooth_series`` (linear, power law h ~ N^0.5, exponential
+run-in r_s + 9 r_s exp(-N / (n/10)), two-phase), 3000 cycles, without noise and with 2 %
+multiplicative noise (noise seeds 0..S-1). One Markdown row per strategy setting, one column
+per shape and noise: "cycles saved % / final relative error %" (noisy columns: mean saved
+(smallest) / largest error over the seeds).
+
+    .venv/bin/python benchmarks/cyclejump_replay.py --smooth [--seeds 5] [--cycles 3000]
 """
 
 from __future__ import annotations
@@ -23,8 +32,10 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from tribodem.cyclejump import (  # noqa: E402
+    SMOOTH_SHAPES,
     make_strategy,
     replay,
+    synthetic_smooth_series,
     synthetic_two_phase_series,
     transition_end,
 )
@@ -42,11 +53,63 @@ CONFIGS: list[tuple[str, str, dict]] = [
 ]
 
 
+SMOOTH_CONFIGS: list[tuple[str, str, dict]] = [
+    ("constant", "defaults (eq 2.20, no step control)", {}),
+    ("constant", "step_control=error (tol 1 %)", {"step_control": "error"}),
+    ("cojocaru", "defaults (tol = q_e/2 = 2.5 %)", {}),
+    ("cojocaru", "step_control=seed (eq 4.2 alone)", {"step_control": "seed"}),
+    ("cojocaru", "q_e = 2 % (tol 1 %)", {"q_e": 0.02}),
+    ("moving", "defaults (tol = q_e/2 = 0.05 %)", {}),
+    ("moving", "step_control=seed (eq 4.4 alone)", {"step_control": "seed"}),
+    ("moving", "q_e = 2 % (tol 1 %)", {"q_e": 0.02}),
+    ("overlapping", "defaults (tol = q_e/2 = 0.05 %)", {}),
+    ("overlapping", "step_control=seed (eq 4.6 alone)", {"step_control": "seed"}),
+    ("overlapping", "q_e = 2 % (tol 1 %)", {"q_e": 0.02}),
+    ("adaptive", "defaults (tol = q_e/2 = 1 %)", {}),
+    ("adaptive", "step_control=seed (before issue 13)", {"step_control": "seed"}),
+    ("adaptive", "tol 0.5 %", {"tol": 0.005}),
+    ("adaptive", "tol 2 %", {"tol": 0.02}),
+]
+
+
+def smooth_table(cycles: int, seeds: int) -> None:
+    """Markdown table of every strategy on the smooth shapes (see the module docstring)."""
+    noises = (0.0, 0.02)
+    series = {(sh, nz): [synthetic_smooth_series(sh, n=cycles, noise=nz, seed=s)
+                         for s in (range(seeds) if nz else [0])]
+              for sh in SMOOTH_SHAPES for nz in noises}
+    cols = [(sh, nz) for sh in SMOOTH_SHAPES for nz in noises]
+    print("| strategy | setting | " + " | ".join(
+        f"{sh}{', 2 % noise' if nz else ''}" for sh, nz in cols) + " | s/run |")
+    print("|---|---|" + "---|" * len(cols) + "---|")
+    for name, label, kw in SMOOTH_CONFIGS:
+        cells = []
+        t0, runs = time.perf_counter(), 0
+        for key in cols:
+            res = [replay(make_strategy(name, **kw), c, inc) for c, inc in series[key]]
+            runs += len(res)
+            saved = [100 * r.cycles_saved_fraction for r in res]
+            err = 100 * max(r.relative_difference for r in res)
+            low = f" ({min(saved):.0f})" if len(res) > 1 else ""
+            cells.append(f"{np.mean(saved):.0f}{low} / {err:.2g}")
+        dt = (time.perf_counter() - t0) / runs
+        print(f"| {name} | {label} | " + " | ".join(cells) + f" | {dt:.2f} |")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--seeds", type=int, default=10)
-    ap.add_argument("--cycles", type=int, default=2000)
+    ap.add_argument("--seeds", type=int, default=None,
+                    help="noise seeds (default 10; 5 with --smooth)")
+    ap.add_argument("--cycles", type=int, default=None,
+                    help="cycles per series (default 2000; 3000 with --smooth)")
+    ap.add_argument("--smooth", action="store_true",
+                    help="the smooth-shape table of the step control (issue 13)")
     args = ap.parse_args()
+    if args.smooth:
+        smooth_table(args.cycles or 3000, 5 if args.seeds is None else args.seeds)
+        return
+    args.seeds = 10 if args.seeds is None else args.seeds
+    args.cycles = args.cycles or 2000
     te = transition_end()
     lin = synthetic_two_phase_series(n=args.cycles, ratio=1.0, noise=0.0)
     noisy = [synthetic_two_phase_series(n=args.cycles, seed=s) for s in range(args.seeds)]

@@ -436,7 +436,7 @@ def test_adaptive_tolerance_bounds_the_final_error(tol):
 ])
 def test_error_controlled_strategies_stay_within_their_tolerance(name, params):
     s = make_strategy(name, **params)
-    tol = s.tol if name == "constant" else s.tolerance
+    tol = s.tolerance
     for shape in ("power", "exponential", "two_phase"):
         c, inc = synthetic_smooth_series(shape, n=SMOOTH_N)
         r = replay(make_strategy(name, **params), c, inc)

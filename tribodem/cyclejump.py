@@ -282,6 +282,11 @@ class ConstantJump(JumpStrategy):
     def foundation(self) -> int:
         return 1
 
+    @property
+    def tolerance(self) -> float:
+        """Relative local error per jump with ``step_control="error"``."""
+        return self.tol
+
     def _rate(self) -> NDArray[np.float64]:
         return (self._states[-1] - self._states[-2]) / (self._cycles[-1] - self._cycles[-2])
 
