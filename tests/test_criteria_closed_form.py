@@ -43,10 +43,8 @@ def axis_stresses(h: HertzSphere, z: np.ndarray) -> tuple[np.ndarray, np.ndarray
     return sz, sr
 
 
-def one_cycle_depth(solver: HalfSpaceSolver, name: str, threshold: float, depth: float,
-                    nz: int) -> tuple[float, dict]:
-    """Deepest wear of the upper body after one frictionless cycle of ``name``."""
-    crit = make_criterion(name, yield_strength=threshold, depth=depth, nz=nz, samples=4)
+def one_cycle(solver: HalfSpaceSolver, crit) -> tuple[np.ndarray, np.ndarray]:  # noqa: ANN001
+    """Wear depth maps (upper, lower) of ``crit`` after one frictionless cycle."""
     crit.set_increments(N_INC)
     grid = TrackGrid(n=solver.n, dx=solver.dx, pad=int(math.ceil(0.3e-3 / solver.dx)) + 1)
     solver.reset()
@@ -54,7 +52,14 @@ def one_cycle_depth(solver: HalfSpaceSolver, name: str, threshold: float, depth:
     crit.begin_cycle(grid, solver)
     for i, s in enumerate(cycle_offsets(0.3e-3, N_INC)):
         crit.add_increment(i, solver.solve_increment(float(s)))
-    du, dl = crit.depths()
+    return crit.depths()
+
+
+def one_cycle_depth(solver: HalfSpaceSolver, name: str, threshold: float, depth: float,
+                    nz: int) -> tuple[float, dict]:
+    """Deepest wear of the upper body after one frictionless cycle of ``name``."""
+    crit = make_criterion(name, yield_strength=threshold, depth=depth, nz=nz, samples=4)
+    du, dl = one_cycle(solver, crit)
     assert du.max() > 0 and dl.max() > 0  # both bodies wear under the same field
     return float(du.max()), crit.info()
 
@@ -97,12 +102,5 @@ def test_threshold_above_the_field_wears_nothing(contact) -> None:
     solver, h = contact
     for name, ratio in (("s22", 1.05), ("von_mises", 0.7)):
         crit = make_criterion(name, yield_strength=ratio * h.peak_pressure, nz=17, samples=4)
-        crit.set_increments(N_INC)
-        grid = TrackGrid(n=solver.n, dx=solver.dx, pad=int(math.ceil(0.3e-3 / solver.dx)) + 1)
-        solver.reset()
-        solver.solve_increment(0.0)
-        crit.begin_cycle(grid, solver)
-        for i, s in enumerate(cycle_offsets(0.3e-3, N_INC)):
-            crit.add_increment(i, solver.solve_increment(float(s)))
-        du, dl = crit.depths()
+        du, dl = one_cycle(solver, crit)
         assert du.max() == 0.0 and dl.max() == 0.0, name
