@@ -296,7 +296,7 @@ class ConstantJump(JumpStrategy):
         if self.step_control == "seed":
             return self.jump_length - 1
         # error control: the rate of the newest cycle is the rate half a cycle back (lag 0.5)
-        kap = self.measured_curvature()
+        kap = self.measured_curvature(_active(self._rate()))
         if math.isnan(kap):  # fewer than 3 measured rates: no evidence of the curvature yet
             return 0
         dx = error_controlled_jump(kap, self.tol, lag=0.5)
