@@ -77,4 +77,12 @@ def run_case(name: str, n: int | None = None, steps: int | None = None,
         "neighbor_builds": sim.nl.builds,
         "mean_height_end_m": float(np.mean(z)),
         "dt_s": sim.dt,
+        "memory": {**sim.memory(), "peak_rss_bytes": _peak_rss()},
     }
+
+
+def _peak_rss() -> float:
+    """Peak resident memory of this process, bytes (Linux: ru_maxrss in KiB)."""
+    import resource
+
+    return float(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss) * 1024.0

@@ -418,6 +418,21 @@ class Simulation:
                 "overlap": ov[act], "normal_force": self.pinfo[act, 1],
                 "force": self.fpair[act]}
 
+    def memory(self) -> dict[str, float]:
+        """Bytes held per particle (particle, wall and per-particle engine arrays), per listed
+        pair (pair list, history, forces) and in total (numpy arrays of the engine)."""
+        n, m = max(self.p.n, 1), max(self.nl.n_pairs, 1)
+        per_particle = [*self.p.arrays().values(), self.p.mass, self.p.inertia, self.force,
+                        self.torque, self.ext_force, self.ext_torque, self.wall_hist,
+                        self.wall_info, self._wforce, self._wtorque, self.nl.start,
+                        self.nl.rev_start, self.nl.ref_pos, self.nl.ref_radius]
+        per_pair = [self.nl.pair_i, self.nl.pair_j, self.nl.rev_pair, self.hist, self.fpair,
+                    self.tpair_i, self.tpair_j, self.pinfo]
+        bp = sum(a.nbytes for a in per_particle)
+        bq = sum(a.nbytes for a in per_pair)
+        return {"bytes_per_particle": bp / n, "bytes_per_pair": bq / m,
+                "pairs_per_particle": self.nl.n_pairs / n, "total_bytes": float(bp + bq)}
+
     # ------------------------------------------------------------------ checkpoints
     def save_checkpoint(self, path: str | Path) -> Path:
         """Write the full state atomically (``.npz``): resuming gives bitwise the same run."""
