@@ -1,0 +1,136 @@
+"""Run CalculiX ``ccx`` as a subprocess with a wall-clock limit and clear failures.
+
+* The job runs in its folder (deck, log ``<job>.log``, ``.sta``, ``.dat``, ``.frd`` kept).
+* ``threads`` sets ``OMP_NUM_THREADS`` and ``CCX_NPROC_EQUATION_SOLVER``.
+* A run longer than ``timeout`` seconds is killed (its whole process group) and raises
+  :class:`CcxTimeoutError` (a bad contact setup can make ccx iterate for ever).
+* A non-zero exit code, an ``*ERROR`` line in the log, or a missing "Job finished" raises
+  :class:`CcxError` (:class:`CcxConvergenceError` when ccx reports divergence or too many
+  cutbacks) carrying the ccx message, the deck path and the last ``.sta`` line.
+* No ``ccx`` executable raises :class:`CcxNotFoundError` naming the install command.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import signal
+import subprocess
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+#: the one command that installs the solver (Debian/Ubuntu package of CalculiX 2.20)
+INSTALL_COMMAND = "apt-get install calculix-ccx"
+
+_CONVERGENCE_WORDS = ("diverge", "cutback", "too many iterations", "increment size smaller",
+                      "no convergence", "not converge")
+
+
+class CcxNotFoundError(FileNotFoundError):
+    """The ccx executable is not on PATH."""
+
+
+class CcxError(RuntimeError):
+    """ccx stopped with an error; ``message`` is ccx's own text, ``deck`` the input file."""
+
+    def __init__(self, what: str, message: str, deck: Path, sta: str = "") -> None:
+        self.message = message
+        self.deck = deck
+        self.sta = sta
+        text = f"{what} (deck {deck}): {message}"
+        if sta:
+            text += f"\nlast .sta line: {sta}"
+        super().__init__(text)
+
+
+class CcxConvergenceError(CcxError):
+    """ccx did not converge (diverging iterations, too many cutbacks)."""
+
+
+class CcxTimeoutError(CcxError):
+    """ccx ran longer than the wall-clock limit and was killed."""
+
+
+@dataclass
+class CcxRun:
+    """A finished ccx job."""
+
+    job: Path  #: ``<folder>/<name>`` without suffix
+    seconds: float  #: wall-clock time of the ccx process, s
+    log: str  #: ccx's standard output and error
+
+    @property
+    def dat(self) -> Path:
+        return self.job.with_suffix(".dat")
+
+    @property
+    def frd(self) -> Path:
+        return self.job.with_suffix(".frd")
+
+
+def find_ccx(executable: str = "ccx") -> str:
+    """Absolute path of ``executable`` on PATH, else :class:`CcxNotFoundError`."""
+    path = shutil.which(executable)
+    if path is None:
+        raise CcxNotFoundError(
+            f"CalculiX solver '{executable}' not found on PATH; install it with: "
+            f"{INSTALL_COMMAND}")
+    return path
+
+
+def _last_sta_line(job: Path) -> str:
+    sta = job.with_suffix(".sta")
+    if not sta.exists():
+        return ""
+    lines = [ln.strip() for ln in sta.read_text(errors="replace").splitlines() if ln.strip()]
+    return lines[-1] if lines else ""
+
+
+def _error_text(log: str) -> str:
+    """The ``*ERROR`` paragraph(s) of a ccx log (up to 6 lines each)."""
+    lines = log.splitlines()
+    out: list[str] = []
+    for i, ln in enumerate(lines):
+        if "*ERROR" in ln:
+            para = [ln.strip()]
+            for nxt in lines[i + 1:i + 6]:
+                if not nxt.strip():
+                    break
+                para.append(nxt.strip())
+            out.append(" ".join(para))
+    return " | ".join(out)
+
+
+def run_ccx(deck: str | Path, threads: int = 1, timeout: float = 600.0,
+            executable: str = "ccx") -> CcxRun:
+    """Run ``ccx -i <job>`` in the deck's folder; see the module docstring for failures."""
+    deck = Path(deck).resolve()
+    if deck.suffix != ".inp" or not deck.exists():
+        raise FileNotFoundError(f"deck {deck} does not exist or is not a .inp file")
+    exe = find_ccx(executable)
+    job = deck.with_suffix("")
+    env = dict(os.environ, OMP_NUM_THREADS=str(int(threads)),
+               CCX_NPROC_EQUATION_SOLVER=str(int(threads)))
+    log_path = job.with_suffix(".log")
+    t0 = time.perf_counter()
+    with open(log_path, "w") as log_file:
+        proc = subprocess.Popen([exe, "-i", job.name], cwd=deck.parent, env=env,
+                                stdout=log_file, stderr=subprocess.STDOUT,
+                                start_new_session=True)
+        try:
+            rc = proc.wait(timeout=timeout)
+        except subprocess.TimeoutExpired:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.wait()
+            raise CcxTimeoutError(f"ccx exceeded the {timeout:g} s wall-clock limit and was "
+                                  "killed", "no result", deck, _last_sta_line(job)) from None
+    seconds = time.perf_counter() - t0
+    log = log_path.read_text(errors="replace")
+    err = _error_text(log)
+    if rc != 0 or err or "Job finished" not in log:
+        message = err or f"exit code {rc}, no 'Job finished' in {log_path}"
+        cls = CcxConvergenceError if any(w in message.lower() for w in _CONVERGENCE_WORDS) \
+            else CcxError
+        raise cls(f"ccx failed (exit code {rc})", message, deck, _last_sta_line(job))
+    return CcxRun(job=job, seconds=seconds, log=log)

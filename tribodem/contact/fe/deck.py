@@ -1,0 +1,231 @@
+"""CalculiX input deck of the plane-strain pad-on-flat fretting model (seed 003 section 3.2.5).
+
+Model (SI units; per unit length: the plane-strain thickness is 1 m, so forces are N/m):
+
+* elements ``CPE4`` (ccx expands them to one layer of 8-node bricks);
+* materials: ``*ELASTIC`` (E, nu) and optionally ``*PLASTIC`` with bilinear isotropic
+  hardening (seed table 5.1): the true stress grows linearly from the yield stress at zero
+  plastic strain to the UTS at the plastic strain ``uts_strain - UTS / E``, i.e. the tangent
+  modulus E_t = (UTS - Y) / (uts_strain - Y / E) of :func:`bilinear_hardening`;
+* contact: ``*CONTACT PAIR, TYPE=SURFACE TO SURFACE``, slave the pad's arc, master the flat;
+  ``*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR`` with the penalty stiffness
+  ``penalty_factor * E / h_fine`` (Pa/m), ``*FRICTION`` mu with the stick slope
+  ``stick_factor`` times that stiffness (Pa/m);
+* boundary conditions: the flat's bottom fixed; every node of the pad's top edge tied to the
+  reference node REF (x = 0) by ``*EQUATION`` in x and y (no rocking), so the normal load is
+  one ``*CLOAD`` and the tangential displacement one ``*BOUNDARY`` on REF;
+* steps: (1) seating: REF moved down by ``seat`` (m) under displacement control, x held;
+  (2) loading: the y displacement released, P (N/m) applied on REF as a ramp, x held;
+  (3) tangential: REF x displacement 0 -> +delta -> 0 -> -delta -> 0 (``*AMPLITUDE`` over a
+  step time of 4), ``n_increments`` fixed increments (``*STATIC, DIRECT``).
+
+Output to the ``.dat`` file every increment: total reaction force of the flat's bottom
+(``*NODE PRINT, TOTALS=ONLY``), displacements of REF and of both contact faces, the
+integration-point stresses of the elements along both contact faces (the contact tractions
+are recovered from them, see :mod:`tribodem.contact.fe.results`) and optionally of the fine
+zones (and PEEQ); optionally to the ``.frd``: displacements, stresses (and PEEQ).
+"""
+
+from __future__ import annotations
+
+import io
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from tribodem.contact.fe.mesh import Mesh
+
+#: engineering strain at the UTS of EN24T used by the tamaas elasto-plastic backend
+UTS_STRAIN_EN24T = 0.132
+
+
+@dataclass(frozen=True)
+class FEMaterial:
+    """Isotropic material of one body; ``yield_strength`` None = purely elastic.
+    Defaults: EN24T, seed table 5.1 (E 240 GPa, nu 0.3, Y 680 MPa, UTS 1000 MPa)."""
+
+    young: float = 240e9  #: Pa
+    poisson: float = 0.3  #: -
+    yield_strength: float | None = None  #: Pa
+    uts: float = 1000e6  #: Pa
+    uts_strain: float = UTS_STRAIN_EN24T  #: total strain at the UTS, -
+
+    def plastic_table(self) -> list[tuple[float, float]]:
+        """``*PLASTIC`` rows (true stress Pa, equivalent plastic strain) of the bilinear law."""
+        if self.yield_strength is None:
+            return []
+        y, u = float(self.yield_strength), float(self.uts)
+        if not (0 < y < u) or self.uts_strain <= u / self.young:
+            raise ValueError(f"bilinear hardening needs 0 < yield < uts and uts_strain > "
+                             f"uts / E; got Y={y!r}, UTS={u!r}, uts_strain={self.uts_strain!r}")
+        return [(y, 0.0), (u, self.uts_strain - u / self.young)]
+
+
+@dataclass(frozen=True)
+class ContactSettings:
+    """Interface law: Coulomb friction ``mu``, linear penalty in normal and stick directions."""
+
+    mu: float = 0.6  #: Coulomb friction coefficient (seed: 0.6)
+    penalty_factor: float = 50.0  #: normal stiffness = factor * E_min / h_fine, Pa/m
+    stick_factor: float = 0.1  #: stick slope = factor * normal stiffness, Pa/m
+    formulation: str = "SURFACE TO SURFACE"  #: ccx contact pair type
+    #: friction coefficient while seating and loading (ccx converges poorly with friction in
+    #: the normal loading; for elastically similar bodies, Dundurs beta = 0, the normal
+    #: problem does not depend on friction)
+    mu_loading: float = 1e-3
+
+
+@dataclass(frozen=True)
+class LoadCase:
+    """Normal load (N/m), tangential amplitude (m) and increments of the tangential cycle."""
+
+    load: float = 1e5  #: P per unit length, N/m
+    delta: float = 0.0  #: tangential displacement amplitude of REF, m (0: no tangential step)
+    n_increments: int = 16  #: increments of the cycle 0 -> +d -> 0 -> -d -> 0 (multiple of 4)
+    half_cycle: bool = False  #: only 0 -> +delta (n_increments / 4 increments)
+    load_increments: int = 5  #: increments of the loading step
+    seat: float = 0.0  #: seating displacement, m (0: 5 % of a^2 / (2 R), set by the writer)
+
+
+def _fmt(v: float) -> str:
+    return f"{v:.9e}"
+
+
+def _write_ids(out: io.StringIO, ids: np.ndarray, per_line: int = 16) -> None:
+    for k in range(0, ids.size, per_line):
+        out.write(", ".join(str(int(i)) for i in ids[k:k + per_line]) + "\n")
+
+
+def _model_data(out: io.StringIO, mesh: Mesh, lower: FEMaterial, upper: FEMaterial,
+                contact: ContactSettings) -> None:
+    out.write("*HEADING\ntribodem fe: plane-strain cylindrical pad on flat\n")
+    out.write("*NODE, NSET=NALL\n")
+    for k, (x, y) in enumerate(mesh.nodes, start=1):
+        out.write(f"{k}, {_fmt(x)}, {_fmt(y)}\n")
+    n_low = mesh.element_sets["LOWER"].size
+    for name, rows, first in (("LOWER", mesh.elements[:n_low], 1),
+                              ("UPPER", mesh.elements[n_low:], n_low + 1)):
+        out.write(f"*ELEMENT, TYPE=CPE4, ELSET={name}\n")
+        for k, conn in enumerate(rows + 1, start=first):
+            out.write(f"{k}, {conn[0]}, {conn[1]}, {conn[2]}, {conn[3]}\n")
+    for name, ids in mesh.node_sets.items():
+        out.write(f"*NSET, NSET={name}\n")
+        _write_ids(out, ids)
+    for name, ids in mesh.element_sets.items():
+        if name not in ("LOWER", "UPPER"):
+            out.write(f"*ELSET, ELSET={name}\n")
+            _write_ids(out, ids)
+    out.write("*ELSET, ELSET=FINE\nLFINE, UFINE\n")
+    for name, (ids, face) in mesh.surfaces.items():
+        out.write(f"*SURFACE, NAME={name}, TYPE=ELEMENT\n")
+        for e in ids:
+            out.write(f"{int(e)}, S{face + 1}\n")
+    for name, mat in (("MLOWER", lower), ("MUPPER", upper)):
+        out.write(f"*MATERIAL, NAME={name}\n*ELASTIC\n{_fmt(mat.young)}, {mat.poisson}\n")
+        table = mat.plastic_table()
+        if table:
+            out.write("*PLASTIC\n")
+            for s, e in table:
+                out.write(f"{_fmt(s)}, {_fmt(e)}\n")
+    out.write("*SOLID SECTION, ELSET=LOWER, MATERIAL=MLOWER\n1.\n")
+    out.write("*SOLID SECTION, ELSET=UPPER, MATERIAL=MUPPER\n1.\n")
+    ref = int(mesh.node_sets["REF"][0])
+    out.write("*EQUATION\n")
+    for n in mesh.node_sets["UTOP"]:
+        if int(n) != ref:
+            for dof in (1, 2):
+                out.write(f"2\n{int(n)}, {dof}, 1., {ref}, {dof}, -1.\n")
+    k_n = contact.penalty_factor * min(lower.young, upper.young) / mesh.h_fine
+    out.write("*SURFACE INTERACTION, NAME=SI\n")
+    out.write(f"*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR\n{_fmt(k_n)}\n")
+    if contact.mu > 0:
+        out.write(f"*FRICTION\n{contact.mu}, {_fmt(contact.stick_factor * k_n)}\n")
+
+
+def _change_friction(out: io.StringIO, mesh: Mesh, lower: FEMaterial, upper: FEMaterial,
+                     contact: ContactSettings, mu: float) -> None:
+    if contact.mu > 0:
+        k_n = contact.penalty_factor * min(lower.young, upper.young) / mesh.h_fine
+        out.write("*CHANGE FRICTION, INTERACTION=SI\n")
+        out.write(f"*FRICTION\n{mu}, {_fmt(contact.stick_factor * k_n)}\n")
+    out.write(f"*CONTACT PAIR, INTERACTION=SI, TYPE={contact.formulation}\nSPAD, SFLAT\n")
+
+
+def _time_points(out: io.StringIO, name: str, times: np.ndarray) -> None:
+    out.write(f"*TIME POINTS, NAME={name}\n")
+    for k in range(0, times.size, 8):
+        out.write(", ".join(f"{t:.12g}" for t in times[k:k + 8]) + "\n")
+
+
+def _outputs(out: io.StringIO, plastic: bool, fine_stress: bool, frd: bool,
+             time_points: str) -> None:
+    tp = f", TIME POINTS={time_points}" if time_points else ""
+    out.write(f"*NODE PRINT, NSET=LBOT, TOTALS=ONLY{tp}\nRF\n")
+    out.write(f"*NODE PRINT, NSET=REF{tp}\nU\n")
+    out.write(f"*NODE PRINT, NSET=UBOT{tp}\nU\n*NODE PRINT, NSET=LTOP{tp}\nU\n")
+    out.write(f"*EL PRINT, ELSET=UCONT{tp}\nS\n*EL PRINT, ELSET=LCONT{tp}\nS\n")
+    if fine_stress:
+        out.write(f"*EL PRINT, ELSET=FINE{tp}\nS\n")
+        if plastic:
+            out.write(f"*EL PRINT, ELSET=FINE{tp}\nPEEQ\n")
+    if frd:
+        out.write(f"*NODE FILE{tp}\nU\n*EL FILE{tp}\nS" + (", PEEQ" if plastic else "") + "\n")
+
+
+def write_deck(path: str | Path, mesh: Mesh, case: LoadCase,
+               lower: FEMaterial | None = None, upper: FEMaterial | None = None,
+               contact: ContactSettings | None = None, fine_stress: bool = True,
+               frd: bool = False) -> Path:
+    """Write the ccx deck for ``mesh`` and ``case`` to ``path`` (``.inp``); returns the path.
+
+    ``fine_stress``: print the integration-point stresses (and PEEQ) of the fine zones to the
+    ``.dat`` every increment; ``frd``: also write displacements and stresses to the ``.frd``
+    (for ParaView via ccx2paraview)."""
+    lower = lower or FEMaterial()
+    upper = upper or FEMaterial()
+    contact = contact or ContactSettings()
+    if case.load <= 0 or not math.isfinite(case.load):
+        raise ValueError(f"load = {case.load!r} is not allowed: must be finite and > 0 N/m")
+    n = int(case.n_increments)
+    if case.delta > 0 and (n < 4 or n % 4):
+        raise ValueError(f"n_increments = {n!r} is not allowed: a multiple of 4, >= 4")
+    plastic = lower.yield_strength is not None or upper.yield_strength is not None
+    radius, a = mesh.info["radius"], mesh.info["a"]
+    seat = case.seat if case.seat > 0 else 0.05 * a * a / (2.0 * radius)
+    ref = int(mesh.node_sets["REF"][0])
+    out = io.StringIO()
+    _model_data(out, mesh, lower, upper, contact)
+    out.write("*AMPLITUDE, NAME=STROKE\n0., 0., 1., 1., 2., 0., 3., -1.\n4., 0.\n")
+    n_load = max(int(case.load_increments), 1)
+    total = 1.0 if case.half_cycle else 4.0
+    n_tan = n // 4 if case.half_cycle else n
+    _time_points(out, "TLOAD", np.arange(1, n_load + 1) / n_load)
+    if case.delta > 0:
+        _time_points(out, "TCYCLE", np.arange(1, n_tan + 1) * (4.0 / n))
+    out.write("*BOUNDARY\nLBOT, 1, 2\n")
+    # step 1: seating under displacement control
+    out.write("*STEP, INC=200\n*STATIC\n0.5, 1., 1e-4, 0.5\n")
+    _change_friction(out, mesh, lower, upper, contact, contact.mu_loading)
+    out.write(f"*BOUNDARY\n{ref}, 1, 1, 0.\n{ref}, 2, 2, {_fmt(-seat)}\n")
+    _outputs(out, plastic, fine_stress, frd, "")
+    out.write("*END STEP\n")
+    # step 2: normal load P on REF (automatic increments <= 1 / n_load, output at 1 / n_load)
+    dt = 1.0 / n_load
+    out.write(f"*STEP, INC=1000\n*STATIC\n{dt}, 1., {dt * 1e-4}, {dt}\n")
+    out.write(f"*BOUNDARY, OP=NEW\nLBOT, 1, 2\n{ref}, 1, 1, 0.\n")
+    out.write(f"*CLOAD\n{ref}, 2, {_fmt(-case.load)}\n")
+    _outputs(out, plastic, fine_stress, frd, "TLOAD")
+    out.write("*END STEP\n")
+    # step 3: tangential displacement cycle (increments <= 4 / n, output every 4 / n)
+    if case.delta > 0:
+        dt = 4.0 / n
+        out.write(f"*STEP, INC=10000\n*STATIC\n{dt}, {total}, {dt * 1e-4}, {dt}\n")
+        _change_friction(out, mesh, lower, upper, contact, contact.mu)
+        out.write(f"*BOUNDARY, AMPLITUDE=STROKE\n{ref}, 1, 1, {_fmt(case.delta)}\n")
+        _outputs(out, plastic, fine_stress, frd, "TCYCLE")
+        out.write("*END STEP\n")
+    path = Path(path)
+    path.write_text(out.getvalue())
+    return path

@@ -1,0 +1,208 @@
+"""Graded plane-strain mesh of a cylindrical pad on a flat block (numpy only, deterministic).
+
+Geometry (SI, metres), x along the stroke, y up, unit thickness (plane strain):
+
+* lower body: the rectangle ``[-W_l, W_l] x [-H_l, 0]``, top face ``y = 0`` (the flat);
+* upper body: a circular-segment pad of radius ``R``: bottom ``y = s(x) = R - sqrt(R^2 - x^2)``
+  (touching the flat at ``x = 0``), vertical sides ``x = +-W_u``, flat top ``y = H_u``.
+
+Both bodies are structured grids of 4-node quadrilaterals (ccx ``CPE4``) built as tensor
+products of two graded 1D coordinate lists: a uniform fine zone of spacing ``h`` under the
+contact (straight node columns ``x = i h``; half-width ``zone_factor a + stroke`` on the flat,
+``zone_factor a`` on the pad, depth ``depth_factor a``), then geometric growth by ``growth``
+per element away from it. In the pad the vertical coordinate is mapped so that the bottom row
+of nodes lies on the arc and the top row on ``y = H_u``.
+
+Node and element numbers are 1-based in the sets below (the ccx convention); ``nodes`` and
+``elements`` arrays are 0-based rows (node ``k`` is row ``k - 1``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+#: ccx face label of each quadrilateral edge (nodes 1-2, 2-3, 3-4, 4-1 counter-clockwise)
+FACES = ("S1", "S2", "S3", "S4")
+
+
+def hertz_line(load: float, radius: float, e_star: float) -> tuple[float, float]:
+    """Hertz line contact (plane strain): (p0, a) in (Pa, m) for a load per unit length
+    ``load`` (N/m) on a cylinder of radius ``radius`` (m) against a flat, contact modulus
+    ``e_star`` (Pa): p0 = sqrt(P E* / (pi R)), a = sqrt(4 P R / (pi E*)) (Johnson 4.45)."""
+    p0 = math.sqrt(load * e_star / (math.pi * radius))
+    a = math.sqrt(4.0 * load * radius / (math.pi * e_star))
+    return p0, a
+
+
+def graded_half(fine: float, h: float, total: float, growth: float) -> NDArray[np.float64]:
+    """Coordinates 0 .. ``total`` (m): uniform spacing ``h`` up to >= ``fine``, then spacings
+    growing by ``growth`` per element; the last spacing is merged so the list ends at ``total``
+    without a sliver (the last element is at most ``growth`` times the one before)."""
+    if not (0 < h <= fine < total) or growth < 1.0:
+        raise ValueError(f"graded_half: need 0 < h <= fine < total and growth >= 1, got "
+                         f"h={h!r}, fine={fine!r}, total={total!r}, growth={growth!r}")
+    n_fine = int(math.ceil(fine / h - 1e-9))
+    xs = list(np.arange(n_fine + 1) * h)
+    step = h
+    while xs[-1] < total:
+        step *= growth
+        xs.append(xs[-1] + step)
+    if len(xs) > n_fine + 2 and xs[-1] - total > 0.5 * step:
+        xs.pop()  # drop the overshooting point, stretch the previous element instead
+    xs[-1] = total
+    return np.asarray(xs, dtype=float)
+
+
+def graded_symmetric(fine: float, h: float, total: float, growth: float) -> NDArray[np.float64]:
+    """Symmetric graded coordinates ``-total .. total`` (m) with a node at 0."""
+    half = graded_half(fine, h, total, growth)
+    return np.concatenate([-half[:0:-1], half])
+
+
+@dataclass
+class Mesh:
+    """2D quadrilateral mesh of the two bodies with the sets the deck needs."""
+
+    nodes: NDArray[np.float64]  #: node coordinates (x, y), m, [n_nodes, 2]
+    elements: NDArray[np.int64]  #: 0-based node rows of each CPE4, counter-clockwise, [n, 4]
+    node_sets: dict[str, NDArray[np.int64]] = field(default_factory=dict)  #: 1-based ids
+    element_sets: dict[str, NDArray[np.int64]] = field(default_factory=dict)  #: 1-based ids
+    #: element-face surfaces: name -> (1-based element ids, face index 0..3 -> S1..S4)
+    surfaces: dict[str, tuple[NDArray[np.int64], int]] = field(default_factory=dict)
+    h_fine: float = 0.0  #: element size in the fine zone, m
+    info: dict[str, float] = field(default_factory=dict)  #: geometry parameters, SI
+
+    @property
+    def n_nodes(self) -> int:
+        return int(self.nodes.shape[0])
+
+    @property
+    def n_elements(self) -> int:
+        return int(self.elements.shape[0])
+
+    def check(self) -> None:
+        """Raise ValueError on inverted or degenerate elements (signed area <= 0)."""
+        p = self.nodes[self.elements]  # [n, 4, 2]
+        x, y = p[..., 0], p[..., 1]
+        area = 0.5 * np.sum(x * np.roll(y, -1, axis=1) - np.roll(x, -1, axis=1) * y, axis=1)
+        bad = np.flatnonzero(area <= 0.0)
+        if bad.size:
+            raise ValueError(f"{bad.size} elements with non-positive area (first: {bad[0] + 1})")
+
+    def to_meshio(self) -> object:
+        """A :class:`meshio.Mesh` (z = 0) with a ``body`` cell field (0 lower, 1 upper)."""
+        import meshio
+
+        pts = np.column_stack([self.nodes, np.zeros(self.n_nodes)])
+        body = np.zeros(self.n_elements, dtype=np.int64)
+        body[self.element_sets["UPPER"] - 1] = 1
+        return meshio.Mesh(pts, [("quad", self.elements)], cell_data={"body": [body]})
+
+    def write_vtk(self, path: str | Path) -> Path:
+        """Write the mesh to a VTK/VTU file (format from the suffix, via meshio)."""
+        path = Path(path)
+        self.to_meshio().write(path)  # type: ignore[attr-defined]
+        return path
+
+
+def _grid(xs: NDArray[np.float64], ys: NDArray[np.float64]) -> tuple[NDArray[np.float64],
+                                                                     NDArray[np.int64]]:
+    """Nodes (row-major: x fastest) and CCW quads of the tensor grid ``xs x ys``."""
+    nx, ny = xs.size, ys.size
+    xx, yy = np.meshgrid(xs, ys)  # [ny, nx]
+    nodes = np.column_stack([xx.ravel(), yy.ravel()])
+    i, j = np.meshgrid(np.arange(nx - 1), np.arange(ny - 1))
+    n1 = (j * nx + i).ravel()
+    quads = np.column_stack([n1, n1 + 1, n1 + 1 + nx, n1 + nx]).astype(np.int64)
+    return nodes, quads
+
+
+@dataclass(frozen=True)
+class PadOnFlat:
+    """Parameters of :func:`cylinder_on_flat` (SI). ``a`` is the Hertz half-width that sets
+    the fine zone (use :func:`hertz_line` of the intended load)."""
+
+    radius: float = 4e-3  #: pad radius R, m (seed: 8 mm diameter cylinders)
+    a: float = 62e-6  #: expected contact half-width, m
+    h_fine: float = 5e-6  #: element size in the fine zone, m
+    stroke: float = 0.0  #: tangential amplitude the flat's fine zone must cover, m
+    zone_factor: float = 1.75  #: fine zone half-width on the pad, in units of a
+    depth_factor: float = 1.5  #: fine zone depth, in units of a
+    size_factor: float = 20.0  #: body half-width and height, in units of a (pad <= 0.4 R)
+    growth: float = 1.2  #: size ratio of neighbouring elements outside the fine zone
+
+
+def cylinder_on_flat(p: PadOnFlat) -> Mesh:
+    """Mesh of the pad (upper) on the flat (lower); see the module docstring.
+
+    Node sets: ``LBOT`` (flat bottom, fixed), ``UTOP`` (pad top, tied), ``REF`` (the pad top
+    node at x = 0, carries the load), ``LTOP`` / ``UBOT`` (contact faces' nodes).
+    Element sets: ``LOWER``, ``UPPER``, ``LFINE``, ``UFINE`` (fine zones), ``UCONT`` (the
+    pad's bottom row), ``LCONT`` (the flat's top row under the master surface).
+    Surfaces: ``SFLAT`` (flat top faces, master), ``SPAD`` (pad arc faces, slave).
+    """
+    h, a, R = p.h_fine, p.a, p.radius
+    half_l = max(p.size_factor * a, p.zone_factor * a + p.stroke + 10 * a)
+    half_u = min(p.size_factor * a, 0.4 * R)  # a segment of the cylinder, at most 0.8 R wide
+    if half_u <= p.zone_factor * a + 2 * p.h_fine:
+        raise ValueError(f"pad half-width {half_u:.3g} m leaves no room outside the fine zone: "
+                         "the contact is too wide for the radius")
+    fine_l = p.zone_factor * a + p.stroke
+    fine_u = p.zone_factor * a
+    depth = p.depth_factor * a
+    # lower body
+    xl = graded_symmetric(fine_l, h, half_l, p.growth)
+    yl = -graded_half(depth, h, p.size_factor * a, p.growth)[::-1]
+    nodes_l, quads_l = _grid(xl, yl)
+    # upper body: eta = height above the arc, mapped to [s(x), H_u]
+    xu = graded_symmetric(fine_u, h, half_u, p.growth)
+    h_top = p.size_factor * a
+    eta = graded_half(depth, h, h_top, p.growth)
+    s = R - np.sqrt(R * R - xu * xu)
+    xx, ee = np.meshgrid(xu, eta)
+    yy = s[None, :] + ee * (h_top - s[None, :]) / h_top
+    nodes_u = np.column_stack([xx.ravel(), yy.ravel()])
+    _, quads_u = _grid(xu, eta)
+    off = nodes_l.shape[0]
+    nodes = np.vstack([nodes_l, nodes_u])
+    elements = np.vstack([quads_l, quads_u + off])
+    nxl, nxu = xl.size, xu.size
+    n_el_l = quads_l.shape[0]
+    ids = np.arange(1, nodes.shape[0] + 1)
+    node_sets = {
+        "LBOT": ids[:nxl],
+        "LTOP": ids[off - nxl:off],
+        "UBOT": ids[off:off + nxu],
+        "UTOP": ids[nodes.shape[0] - nxu:],
+    }
+    node_sets["REF"] = node_sets["UTOP"][[int(np.argmin(np.abs(xu)))]]
+    el_ids = np.arange(1, elements.shape[0] + 1)
+    cen = nodes[elements].mean(axis=1)
+    lower = el_ids[:n_el_l]
+    upper = el_ids[n_el_l:]
+    in_fine_l = (np.abs(cen[:n_el_l, 0]) < fine_l + h) & (cen[:n_el_l, 1] > -depth - h)
+    in_fine_u = (np.abs(cen[n_el_l:, 0]) < fine_u + h) & (cen[n_el_l:, 1] < depth + h)
+    # contact faces: the flat's top row (S3) and the pad's bottom row (S1), cut to a margin
+    top_row = lower[-(nxl - 1):]
+    bot_row = upper[:nxu - 1]
+    flat_faces = top_row[np.abs(cen[top_row - 1, 0]) < fine_l + 8 * a]
+    pad_faces = bot_row[np.abs(cen[bot_row - 1, 0]) < fine_u + 2 * a]
+    mesh = Mesh(
+        nodes=nodes,
+        elements=elements,
+        node_sets=node_sets,
+        element_sets={"LOWER": lower, "UPPER": upper, "LFINE": lower[in_fine_l],
+                      "UFINE": upper[in_fine_u], "UCONT": bot_row, "LCONT": flat_faces},
+        surfaces={"SFLAT": (flat_faces, 2), "SPAD": (pad_faces, 0)},
+        h_fine=h,
+        info={"radius": R, "a": a, "half_lower": half_l, "half_upper": half_u,
+              "height_lower": p.size_factor * a, "height_upper": h_top, "fine_lower": fine_l,
+              "fine_upper": fine_u, "fine_depth": depth},
+    )
+    mesh.check()
+    return mesh
