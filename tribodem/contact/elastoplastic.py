@@ -36,6 +36,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import tamaas as tm
@@ -45,7 +46,12 @@ from scipy.interpolate import RegularGridInterpolator
 
 from tribodem.contact.base import Body, IncrementResult, SubsurfaceStress, _check_positive
 from tribodem.contact.geometry import Recession
-from tribodem.contact.halfspace import HalfSpaceSolver, _estimate_contact_radius
+from tribodem.contact.halfspace import (
+    HalfSpaceSolver,
+    _estimate_contact_radius,
+    model_fields,
+    set_model_fields,
+)
 
 #: EN24T (seed table 5.1): yield and ultimate tensile strength, Pa.
 YIELD_EN24T = 680e6
@@ -221,6 +227,47 @@ class ElastoPlasticSolver(HalfSpaceSolver):
         self.ep_pressure: NDArray[np.float64] | None = None
         #: plastic surface displacement of each body, m, [ep_n, ep_n]
         self.plastic_displacement: NDArray[np.float64] | None = None
+
+    def state_dict(self) -> dict[str, Any]:
+        """:meth:`HalfSpaceSolver.state_dict` plus the plastic state: the EPIC model's fields
+        (plastic strain, cumulated plastic strain, stress, ...), the EP surface, the plastic
+        surface displacement and the load steps not yet collected.
+
+        EPIC's own residual displacement is not reachable from Python, so a run with
+        ``reload_cycles`` (EPIC re-solved every cycle) cannot be checkpointed
+        (``NotImplementedError``); without it EPIC runs only at the first loading.
+        """
+        if self.reload_cycles and self._ep_loaded:
+            raise NotImplementedError("reload_cycles = True: EPIC's internal residual "
+                                      "displacement cannot be saved; no checkpoint")
+        return {
+            **super().state_dict(),
+            "ep_loaded": self._ep_loaded,
+            "ep": model_fields(self._ep),
+            "aux": model_fields(self._aux),
+            "ep_surface": self._ep_surface.copy(),
+            "ep_pressure": None if self.ep_pressure is None else self.ep_pressure.copy(),
+            "plastic_displacement": (None if self.plastic_displacement is None
+                                     else self.plastic_displacement.copy()),
+            "steps": list(self._steps),
+        }
+
+    def load_state_dict(self, state: dict[str, Any]) -> None:
+        """Restore :meth:`state_dict` (same grids)."""
+        super().load_state_dict(state)
+        set_model_fields(self._ep, state["ep"])
+        set_model_fields(self._aux, state["aux"])
+        self._ep_surface[...] = state["ep_surface"]
+        self._ep_loaded = bool(state["ep_loaded"])
+        self._steps = list(state["steps"])
+        pe, up = state["ep_pressure"], state["plastic_displacement"]
+        self.ep_pressure = None if pe is None else np.array(pe, dtype=float)
+        self.plastic_displacement = None if up is None else np.array(up, dtype=float)
+        self._plastic_map = None
+        if self.plastic_displacement is not None:
+            c = self.ep_coords
+            self._plastic_map = RegularGridInterpolator(
+                (c, c), self.plastic_displacement, bounds_error=False, fill_value=0.0)
 
     def begin_cycle(self) -> None:
         """Elastic-plastic normal solve at offset 0 on the current (worn) surfaces.

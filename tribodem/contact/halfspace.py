@@ -29,6 +29,7 @@ Model (seed 003 sections 3.3 and 6.1, replacing the Abaqus FE phase):
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 import tamaas as tm
@@ -58,6 +59,25 @@ _WARM_STARTS = 64
 
 class WindowTooSmallError(RuntimeError):
     """The contact reached the edge of the periodic window: enlarge ``window``."""
+
+
+def model_fields(model: tm.Model) -> dict[str, NDArray[np.float64]]:
+    """Copies of every field of a tamaas model (tamaas objects cannot be pickled)."""
+    return {k: np.array(model[k], dtype=float) for k in list(model)}
+
+
+def set_model_fields(model: tm.Model, fields: dict[str, NDArray[np.float64]]) -> None:
+    """Write :func:`model_fields` back into a model of the same discretisation, in place."""
+    have = set(model)
+    for k, v in fields.items():
+        if k not in have:  # registered by a solver on first use (e.g. 'gap')
+            model[k] = np.array(v, dtype=float)
+            continue
+        dst = model[k]
+        if np.shape(dst) != np.shape(v):
+            raise ValueError(f"tamaas field {k!r}: shape {np.shape(v)} does not fit "
+                             f"{np.shape(dst)}")
+        dst[...] = v
 
 
 def _estimate_contact_radius(
@@ -163,6 +183,48 @@ class HalfSpaceSolver(FirstBodySolver):
         # normal solution (model traction) last found at each offset: the initial guess when
         # that offset comes back (next cycle's geometry differs only by one cycle's wear)
         self._warm: dict[float, NDArray[np.float64]] = {}
+
+    def state_dict(self) -> dict[str, Any]:
+        """The load history, for a checkpoint: everything :meth:`reset` clears plus the
+        debris pressure and the tamaas models' fields (the warm starts of the normal
+        solves), as floats and numpy arrays. The surfaces (``upper``, ``lower``) are not
+        included: their owner sets them. :meth:`load_state_dict` restores it bitwise."""
+        keys = list(self._warm)
+        n = self.n
+        return {
+            "offset": self._offset, "direction": self._direction,
+            "rev_offset": self._rev_offset, "rev_traction": self._rev_traction.copy(),
+            "factor": self._factor, "slip_acc": self._slip_acc.copy(),
+            "traction": self._traction.copy(),
+            "warm_keys": np.array(keys, dtype=float),
+            "warm": (np.stack([self._warm[k] for k in keys]) if keys
+                     else np.zeros((0, n, n))),
+            "model": model_fields(self._model),
+            "model_star": model_fields(self._model_star),
+            "debris_pressure": self.debris_pressure.copy(), "debris_load": self.debris_load,
+            "debris_u": self._debris_u.copy(),
+        }
+
+    def load_state_dict(self, state: dict[str, Any]) -> None:
+        """Restore :meth:`state_dict` (same grid: ``ValueError`` otherwise)."""
+        n = self.n
+        if np.shape(state["traction"]) != (n, n):
+            raise ValueError(f"solver state of shape {np.shape(state['traction'])} does not "
+                             f"fit this solver's ({n}, {n}) window")
+        self._offset = state["offset"]
+        self._direction = float(state["direction"])
+        self._rev_offset = float(state["rev_offset"])
+        self._rev_traction = np.array(state["rev_traction"], dtype=float)
+        self._factor = float(state["factor"])
+        self._slip_acc = np.array(state["slip_acc"], dtype=float)
+        self._traction = np.array(state["traction"], dtype=float)
+        self._warm = {float(k): np.array(w, dtype=float)
+                      for k, w in zip(state["warm_keys"], state["warm"], strict=True)}
+        set_model_fields(self._model, state["model"])
+        set_model_fields(self._model_star, state["model_star"])
+        self.debris_pressure = np.array(state["debris_pressure"], dtype=float)
+        self.debris_load = float(state["debris_load"])
+        self._debris_u = np.array(state["debris_u"], dtype=float)
 
     def set_debris_pressure(self, pressure: NDArray[np.float64] | None) -> None:
         """Prescribe the debris (third-body) pressure on the window, Pa [n, n] (None clears).

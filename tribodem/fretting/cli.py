@@ -5,6 +5,8 @@ Python API: :func:`run_fretting` (config -> files in ``out``, returns the summar
 
 from __future__ import annotations
 
+import inspect
+import json
 import time
 from pathlib import Path
 from typing import Annotated, Any, Literal
@@ -12,7 +14,15 @@ from typing import Annotated, Any, Literal
 import typer
 from pydantic import BaseModel, ConfigDict, Field, field_validator
 
-from tribodem.contact import ElasticBody, ElastoPlasticSolver, HalfSpaceSolver, crossed_cylinders
+from tribodem import __version__
+from tribodem.contact import (
+    ElasticBody,
+    ElastoPlasticSolver,
+    HalfSpaceSolver,
+    HertzSphere,
+    contact_modulus,
+    crossed_cylinders,
+)
 from tribodem.cyclejump import STRATEGIES, make_strategy
 from tribodem.fretting.criteria import (
     ALPHA_SEED,
@@ -26,11 +36,16 @@ from tribodem.fretting.criteria import (
 from tribodem.fretting.debris import DebrisField, DebrisSettings
 from tribodem.fretting.loop import FrettingHistory, FrettingLoop
 from tribodem.fretting.output import (
+    CHECKPOINT,
+    read_checkpoint,
+    write_checkpoint,
     write_debris_outputs,
     write_figures,
     write_results,
+    write_rows,
     write_vtk_surfaces,
 )
+from tribodem.io import runs
 from tribodem.io.config import ConfigError, dump_toml, load_toml, merge, validate
 from tribodem.io.results import write_text
 
@@ -128,8 +143,13 @@ class DebrisConfig(_Model):
 
 
 class OutputConfig(_Model):
+    """What is written besides results.csv / summary.json / config.toml (which always are)."""
+
     figures: bool = True
     vtk: bool = True
+    checkpoint_every: int = Field(
+        1, ge=1, description="checkpoint.npz and results.csv rewritten every K simulated "
+        "cycles (and at the end)")
 
 
 class FrettingConfig(_Model):
@@ -173,6 +193,56 @@ def build_criterion(cfg: FrettingConfig) -> Criterion:
         raise ConfigError(f"wear: {err}") from None
 
 
+#: Smallest ``contact.window`` allowed, in Hertz contact radii of the unworn bodies.
+MIN_WINDOW_RADII = 4.0
+
+
+def hertz_radius(cfg: FrettingConfig) -> float:
+    """Hertz contact radius of the unworn crossed cylinders, m: a = (3 P R / (4 E*))^(1/3),
+    R the cylinders' radius (equal crossed cylinders act as a sphere of that radius)."""
+    c = cfg.contact
+    mat = ElasticBody(young=c.young, poisson=c.poisson)
+    return HertzSphere(c.diameter / 2, c.load, contact_modulus(mat, mat)).contact_radius
+
+
+def check_window(cfg: FrettingConfig) -> None:
+    """Refuse (``ConfigError``) a ``contact.window`` that cannot hold the contact.
+
+    The window travels with the upper body and the crossed-cylinder contact stays at its
+    centre through the stroke (the lower track grid covers the stroke separately), so the
+    window must hold the contact, diameter 2 a, with a margin of a on each side for the
+    periodic images and the contact's growth with wear: window >= 4 a.
+    """
+    c = cfg.contact
+    if c.window is None:
+        return
+    a = hertz_radius(cfg)
+    low = MIN_WINDOW_RADII * a
+    if c.window < low:
+        mat = ElasticBody(young=c.young, poisson=c.poisson)
+        raise ConfigError(
+            f"contact.window = {c.window!r} m cannot hold the contact: the Hertz contact of "
+            f"the crossed cylinders (load {c.load:g} N, E* {contact_modulus(mat, mat):.4g} Pa,"
+            f" R {c.diameter / 2:g} m) has radius a = {a:.4g} m; allowed: >= {low:.4g} m "
+            f"({MIN_WINDOW_RADII:g} a; the window travels with the upper body, so the stroke "
+            "does not enter), or leave it out for 10 a")
+
+
+def check_jump_params(strategy: str, params: dict[str, Any]) -> None:
+    """Refuse (``ConfigError``) ``jump.params`` keys the strategy does not take, naming the
+    key and the strategy's parameters."""
+    if strategy == "none" or strategy not in STRATEGIES:
+        return
+    sig = inspect.signature(STRATEGIES[strategy])
+    allowed = [k for k, p in sig.parameters.items()
+               if p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)]
+    for key, value in params.items():
+        if key not in allowed:
+            raise ConfigError(
+                f"jump.params.{key} = {value!r}: not a parameter of strategy '{strategy}'; "
+                f"allowed: {', '.join(allowed)}")
+
+
 def build_loop(cfg: FrettingConfig) -> FrettingLoop:
     """Solver + criterion + strategy from a validated config (``ConfigError`` if unusable)."""
     if cfg.wear.criterion == "dfdi" and cfg.solver != "elastic-plastic":
@@ -180,6 +250,7 @@ def build_loop(cfg: FrettingConfig) -> FrettingLoop:
             f"wear.criterion = 'dfdi' with solver = {cfg.solver!r}: DFDI (eqs 6.1-6.2) needs "
             "the equivalent plastic strain; allowed: solver = 'elastic-plastic'"
         )
+    check_window(cfg)
     crit = build_criterion(cfg)
     c = cfg.contact
     mat = ElasticBody(young=c.young, poisson=c.poisson)
@@ -201,6 +272,7 @@ def build_loop(cfg: FrettingConfig) -> FrettingLoop:
         raise ConfigError(f"contact: {err}") from None
     strategy = None
     if cfg.jump.strategy != "none":
+        check_jump_params(cfg.jump.strategy, cfg.jump.params)
         try:
             params = dict(cfg.jump.params)
             if cfg.jump.strategy == "adaptive":  # decide on the worn volume (docs/fretting.md)
@@ -224,34 +296,124 @@ def build_loop(cfg: FrettingConfig) -> FrettingLoop:
 
 
 def resolve_config(config: Path | None, quick: bool = False,
-                   overrides: dict[str, Any] | None = None) -> FrettingConfig:
-    """Defaults <- config file <- ``--quick`` preset <- command-line overrides."""
-    data: dict[str, Any] = load_toml(config) if config is not None else {}
-    source = str(config) if config is not None else "command line"
+                   overrides: dict[str, Any] | None = None,
+                   base: dict[str, Any] | None = None) -> FrettingConfig:
+    """Defaults <- config file <- ``--quick`` preset <- command-line overrides.
+
+    ``base``: the resolved config of a checkpoint, used in place of a config file (a resumed
+    run without ``--config``).
+    """
+    if config is not None:
+        data: dict[str, Any] = load_toml(config)
+        source = str(config)
+    else:
+        data, source = dict(base or {}), "command line"
     if quick:
-        data = merge(QUICK, data) if config is None else merge(data, QUICK)
+        data = merge(QUICK, data) if config is None and base is None else merge(data, QUICK)
     data = merge(data, overrides or {})
     return validate(FrettingConfig, data, source=source)
 
 
-def run_fretting(cfg: FrettingConfig, out: Path, echo: Any = None) -> dict[str, Any]:
-    """Run the loop and write results.csv, summary.json, config.toml, figures, VTK to ``out``."""
-    loop = build_loop(cfg)
+def _flat(d: dict[str, Any], prefix: str = "") -> dict[str, Any]:
+    out: dict[str, Any] = {}
+    for k, v in d.items():
+        if isinstance(v, dict):
+            out |= _flat(v, f"{prefix}{k}.")
+        else:
+            out[f"{prefix}{k}"] = v
+    return out
+
+
+def _jsonable(cfg: FrettingConfig) -> dict[str, Any]:
+    return json.loads(json.dumps(cfg.model_dump()))
+
+
+#: Config fields a resumed run may change: ``cycles`` (raised, to extend a run) and the
+#: ``[output]`` table (what is written, not the numbers).
+RESUME_MAY_CHANGE = ("cycles", "output.")
+
+
+def check_resume(cfg: FrettingConfig, meta: dict[str, Any], path: Path) -> None:
+    """Refuse (``ConfigError``) resuming checkpoint ``path`` with a different config (every
+    differing field named with both values) or fewer cycles than it already has."""
+    old = _flat(meta.get("config") or {})
+    new = _flat(_jsonable(cfg))
+    absent = "<absent>"
+    diffs = [f"{k} = {new.get(k, absent)!r} (checkpoint: {old.get(k, absent)!r})"
+             for k in sorted(set(old) | set(new))
+             if not k.startswith(RESUME_MAY_CHANGE) and old.get(k, absent) != new.get(k, absent)]
+    if diffs:
+        raise ConfigError(
+            f"--resume: the config differs from the one checkpoint '{path}' was made with: "
+            + "; ".join(diffs) + "; allowed: the checkpoint's values (only cycles, to extend "
+            "the run, and the [output] table may change)")
+    done = int(meta.get("cycles_done", 0))
+    if cfg.cycles < done:
+        raise ConfigError(f"cycles = {cfg.cycles}: checkpoint '{path}' is already at cycle "
+                          f"{done}; allowed: >= {done}")
+
+
+def run_fretting(cfg: FrettingConfig, out: Path, echo: Any = None, resume: bool = False,
+                 progress: bool = False,
+                 checkpoint: tuple[dict[str, Any], dict[str, Any]] | None = None
+                 ) -> dict[str, Any]:
+    """Run the loop and write results.csv, summary.json, config.toml, figures, VTK to ``out``.
+
+    Checks ``out`` (and, with ``resume``, its checkpoint against ``cfg``) before any work;
+    ``checkpoint``: the (meta, state) already read from it. While running, ``out/results.csv``
+    and ``out/checkpoint.npz`` are rewritten (atomically) every ``output.checkpoint_every``
+    simulated cycles; ``resume`` continues from that checkpoint, bitwise as if the run had
+    not stopped. An early stop (contact outgrew the window) writes every output so far,
+    then raises :class:`tribodem.io.runs.RunStopped`.
+    """
     out = Path(out)
+    ck = out / CHECKPOINT
+    runs.check_out_dir(out, "--out", resume=resume, need=(CHECKPOINT,) if resume else ())
+    state: dict[str, Any] | None = None
+    if resume:
+        meta, state = checkpoint if checkpoint is not None else read_checkpoint(ck)
+        check_resume(cfg, meta, ck)
+    loop = build_loop(cfg)
+    if state is not None:
+        try:
+            loop.load_state_dict(state)
+        except (KeyError, TypeError, ValueError) as err:
+            raise ConfigError(f"checkpoint '{ck}' cannot be read: it does not fit this run: "
+                              f"{type(err).__name__}: {err}") from None
+    runs.announce(out, ck, resume_hint="add --resume to the same command")
+    if resume:
+        runs.checkpoint_written(ck)
     out.mkdir(parents=True, exist_ok=True)
+    if not resume:  # a new run: an older run's checkpoint must not pass for this one's
+        ck.unlink(missing_ok=True)
+    resolved = cfg.model_dump()
+    write_text(out / "config.toml", dump_toml(resolved))
     t0 = time.perf_counter()
     every = max(1, cfg.cycles // 10)
+    meta_cfg = _jsonable(cfg)
 
-    def progress(row: dict[str, Any]) -> None:
-        if echo is not None and (row["cycle"] % every == 0 or row["cycle"] == cfg.cycles):
-            echo(f"cycle {row['cycle']}/{cfg.cycles}{' (jumped)' if row['jumped'] else ''}: "
-                 f"wear depth upper {row['wear_depth_upper_m']:.4g} m, lower "
-                 f"{row['wear_depth_lower_m']:.4g} m")
+    def save(lp: FrettingLoop) -> None:
+        assert lp.history is not None
+        write_checkpoint(ck, {"config": meta_cfg, "cycles_done": lp.cycles_done,
+                              "tribodem": __version__}, lp.state_dict())
+        runs.checkpoint_written(ck)
+        write_rows(lp.history, out)  # never ahead of the checkpoint
 
-    hist: FrettingHistory = loop.run(cfg.cycles, progress=progress)
-    resolved = cfg.model_dump()
-    write_text(out / "config.toml", dump_toml(_tomlable(resolved)))
-    files: list[str] = ["results.csv", "summary.json", "config.toml"]
+    with runs.progress(cfg.cycles, "cycle", "fretting run", enabled=progress,
+                       initial=loop.cycles_done) as bar:
+        def report(row: dict[str, Any]) -> None:
+            bar.update(1)
+            bar.set_postfix_str(f"wear depth lower {row['wear_depth_lower_m']:.3g} m")
+            if echo is not None and not progress and (
+                    row["cycle"] % every == 0 or row["cycle"] == cfg.cycles):
+                echo(f"cycle {row['cycle']}/{cfg.cycles}"
+                     f"{' (jumped)' if row['jumped'] else ''}: wear depth upper "
+                     f"{row['wear_depth_upper_m']:.4g} m, lower "
+                     f"{row['wear_depth_lower_m']:.4g} m")
+
+        hist: FrettingHistory = loop.run(cfg.cycles, progress=report, checkpoint=save,
+                                         checkpoint_every=cfg.output.checkpoint_every)
+    files: list[str] = ["results.csv", "summary.json", "config.toml", CHECKPOINT]
     if cfg.output.figures:
         files += [p.name for p in write_figures(hist, out)]
     if cfg.output.vtk:
@@ -269,12 +431,11 @@ def run_fretting(cfg: FrettingConfig, out: Path, echo: Any = None) -> dict[str, 
         "files": files,
         "config": resolved,
     }
-    return write_results(hist, out, extra)
-
-
-def _tomlable(d: dict[str, Any]) -> dict[str, Any]:
-    return {k: _tomlable(v) if isinstance(v, dict) else ("none" if v is None else v)
-            for k, v in d.items()}
+    summary = write_results(hist, out, extra)
+    if hist.stopped:
+        raise runs.RunStopped(f"{hist.stopped} (results.csv, summary.json and figures up "
+                              f"to cycle {loop.cycles_done} are written)")
+    return summary
 
 
 fretting_app = typer.Typer(help="Fretting wear loop (seed 003 chapters 5-6).",
@@ -303,8 +464,18 @@ def run_cmd(
         "--no-debris", help="Switch the debris third body off (overrides the config).")
     ] = False,
     quick: Annotated[bool, typer.Option("--quick", help="64^2 grid, 10 cycles.")] = False,
+    resume: Annotated[bool, typer.Option(
+        "--resume", help=f"Continue from OUT/{CHECKPOINT} (same config; --cycles may be "
+        "raised).")] = False,
+    progress: Annotated[bool, typer.Option(
+        "--progress/--no-progress", help="Progress bar with ETA on stderr.")] = True,
 ) -> None:
     """Run the fretting wear loop; writes results.csv, summary.json, figures, VTK to --out."""
+    for opt, value, allowed in (("--criterion", criterion, tuple(CRITERIA)),
+                                ("--jump", jump, ("none", *STRATEGIES)),
+                                ("--solver", solver, ("elastic", "elastic-plastic"))):
+        if value is not None and value not in allowed:
+            raise ConfigError(f"{opt} = {value!r}: allowed: {', '.join(allowed)}")
     ov: dict[str, Any] = {}
     if criterion is not None:
         ov.setdefault("wear", {})["criterion"] = criterion
@@ -320,14 +491,15 @@ def run_cmd(
         ov.setdefault("debris", {})["every"] = debris_every
     if no_debris:
         ov.setdefault("debris", {})["every"] = None
-    cfg = resolve_config(config, quick=quick, overrides=ov)
-    summary = run_fretting(cfg, out, echo=typer.echo)
+    runs.check_out_dir(out, "--out", resume=resume, need=(CHECKPOINT,) if resume else ())
+    ck = read_checkpoint(out / CHECKPOINT) if resume else None
+    cfg = resolve_config(config, quick=quick, overrides=ov,
+                         base=ck[0].get("config") if ck is not None else None)
+    summary = run_fretting(cfg, out, echo=typer.echo, resume=resume, progress=progress,
+                           checkpoint=ck)
     typer.echo(
         f"done: {summary['cycles']} cycles ({summary['cycles_simulated']} simulated, "
         f"{summary['cycles_jumped']} jumped) in {summary['wall_time_s']:.1f} s; worn volume "
         f"upper {summary['wear_volume_upper_m3']:.4g} m^3, lower "
         f"{summary['wear_volume_lower_m3']:.4g} m^3 -> {out}"
     )
-    if summary["stopped"]:
-        typer.echo(f"run stopped: {summary['stopped']}", err=True)
-        raise typer.Exit(3)

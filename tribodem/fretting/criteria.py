@@ -157,6 +157,19 @@ class Criterion(ABC):
 
     name: ClassVar[str] = "base"
     kind: ClassVar[str] = "rate"  #: "rate" or "threshold"
+    #: attributes not carried from one cycle to the next (remade by :meth:`begin_cycle`),
+    #: left out of :meth:`state`
+    _SCRATCH: ClassVar[frozenset[str]] = frozenset(
+        {"grid", "solver", "_up", "_lo", "_h_up", "_h_lo", "_idx"})
+
+    def state(self) -> dict[str, Any]:
+        """Everything the criterion carries across cycles (Miner sums, DFDI, the grid depth
+        fixed at the first cycle, last-cycle diagnostics), picklable, for a checkpoint."""
+        return {k: v for k, v in vars(self).items() if k not in self._SCRATCH}
+
+    def set_state(self, state: dict[str, Any]) -> None:
+        """Restore :meth:`state` (the next :meth:`begin_cycle` remakes the scratch)."""
+        vars(self).update(state)
 
     def begin_cycle(self, grid: TrackGrid, solver: FirstBodySolver) -> None:
         """Reset the per-cycle accumulators."""

@@ -179,6 +179,11 @@ class FrettingLoop:
         self.de_phases: list[DEPhaseResult] = []
         self._cycle = 0
         self._p_load = np.zeros((n, n))  # total pressure at the loading position, Pa
+        self.history: FrettingHistory | None = None  #: set by the first loading
+        self._done = 0  # cycles recorded (simulated + jumped)
+        self._observe_pending = False  # last cycle of a finished run not shown to strategy
+        self._last_per: dict[str, Any] = {}  # per-cycle values of the last simulated cycle
+        self._wall = 0.0  # wall time of earlier sessions (resumed runs), s
 
     def _de_phase(self) -> dict[str, float]:
         """Seed 003 figure 3.1 DE step: load the debris, map its forces back to the solver."""
@@ -290,40 +295,174 @@ class FrettingLoop:
             **per_cycle,
         }
 
-    def run(
-        self,
-        cycles: int,
-        progress: Callable[[dict[str, Any]], None] | None = None,
-    ) -> FrettingHistory:
-        """Run ``cycles`` cycles (simulated or jumped). A contact that outgrows the solver
-        window stops the run early (``history.stopped`` says why; rows so far are kept)."""
-        if int(cycles) != cycles or cycles < 1:
-            raise ValueError(f"cycles = {cycles!r} is not allowed: must be an integer >= 1")
-        t0 = time.perf_counter()
+    def _new_history(self) -> FrettingHistory:
         g = self.grid
-        j = g.n // 2
-        hist = FrettingHistory(
+        return FrettingHistory(
             rows=[], grid=g, wear_upper=self.wear_upper, wear_lower=self.wear_lower,
             profiles_upper=[], profiles_lower=[],
             base_upper=np.asarray(self.base_upper(g.x_upper, np.zeros(g.n)), dtype=float),
             base_lower=np.asarray(self.base_lower(g.x_lower, np.zeros(g.n_track)), dtype=float),
+            debris=self.debris,
         )
 
-        def record(row: dict[str, Any]) -> None:
-            hist.rows.append(row)
-            hist.profiles_upper.append(self.wear_upper[:, j].copy())
-            hist.profiles_lower.append(self.wear_lower[:, j].copy())
-            if progress is not None:
-                progress(row)
+    def _record(self, row: dict[str, Any],
+                progress: Callable[[dict[str, Any]], None] | None) -> None:
+        hist = self.history
+        assert hist is not None
+        j = self.grid.n // 2
+        hist.rows.append(row)
+        hist.profiles_upper.append(self.wear_upper[:, j].copy())
+        hist.profiles_lower.append(self.wear_lower[:, j].copy())
+        if progress is not None:
+            progress(row)
 
-        self.solver.reset()
+    def _jump(self, c: int, cycles: int, per: dict[str, Any],
+              progress: Callable[[dict[str, Any]], None] | None) -> int:
+        """Show cycle ``c`` to the strategy and jump if it proposes so; returns the cycle
+        reached."""
+        assert self.strategy is not None and self.history is not None
+        self.strategy.observe(c, self._state())
+        n = min(int(self.strategy.propose_jump()), cycles - c)
+        if n <= 0:
+            return c
+        old = self._state()
+        new = np.asarray(self.strategy.extrapolate(old, n), dtype=float)
+        new = np.maximum(new, old)  # wear never heals
+        for k in range(1, n + 1):
+            prev = self._state()
+            self._set_state(old + (new - old) * (k / n))
+            self._cycle += 1
+            if self.debris is not None:
+                dd = self._state() - prev
+                ku = self.wear_upper.size
+                self._generate_debris(dd[:ku].reshape(self.wear_upper.shape),
+                                      dd[ku:].reshape(self.wear_lower.shape))
+                per = per | {"debris_particles": self.debris.n, "de_phase": 0}
+            self._record(self._row(c + k, True, per), progress)
+        self.history.cycles_jumped += n
+        return c + n
+
+    @property
+    def cycles_done(self) -> int:
+        """Cycles recorded so far (simulated + jumped; 0 before the first loading)."""
+        return self._done
+
+    def state_dict(self) -> dict[str, Any]:
+        """The loop's full state between two cycles, for a checkpoint.
+
+        Wear maps, cycle counters, the rows and central profiles recorded so far, the
+        solver's load history (warm starts, plastic state: ``solver.state_dict()``), the
+        criterion's state carried across cycles (Miner sums, DFDI), the jump strategy's and
+        the debris field's state (particles, counters, random generator) and the DE phases,
+        the loading-position pressure. Nested dicts of numpy arrays and picklable Python
+        objects; :meth:`load_state_dict` on a loop built from the same config restores it
+        so that the run continues bitwise as if it had not stopped.
+        """
+        hist = self.history
+        if hist is None:
+            raise RuntimeError("nothing to save before the first loading (run() first)")
+        save = getattr(self.solver, "state_dict", None)
+        if not callable(save):
+            raise TypeError(f"{type(self.solver).__name__} cannot save its state "
+                            "(no state_dict method)")
+        return {
+            "cycle": self._cycle, "done": self._done,
+            "observe_pending": self._observe_pending, "last_per": dict(self._last_per),
+            "wall_time_s": hist.wall_time_s,
+            "wear_upper": self.wear_upper.copy(), "wear_lower": self.wear_lower.copy(),
+            "p_load": np.asarray(self._p_load, dtype=float).copy(),
+            "solver": save(),
+            "criterion": self.criterion.state(),
+            "strategy": None if self.strategy is None else dict(vars(self.strategy)),
+            "debris": None if self.debris is None else dict(vars(self.debris)),
+            "de_phases": list(self.de_phases),
+            "rows": list(hist.rows),
+            "profiles_upper": list(hist.profiles_upper),
+            "profiles_lower": list(hist.profiles_lower),
+            "cycles_simulated": hist.cycles_simulated,
+            "cycles_jumped": hist.cycles_jumped,
+        }
+
+    def load_state_dict(self, state: dict[str, Any]) -> None:
+        """Restore :meth:`state_dict` (``ValueError`` if it does not fit this loop)."""
+        if (self.strategy is None) != (state["strategy"] is None):
+            raise ValueError("the saved state and this loop differ in cycle-jumping")
+        if (self.debris is None) != (state["debris"] is None):
+            raise ValueError("the saved state and this loop differ in debris")
+        for name in ("wear_upper", "wear_lower"):
+            have, got = getattr(self, name).shape, np.shape(state[name])
+            if have != got:
+                raise ValueError(f"saved {name} has shape {got}, this loop {have}")
+        self.wear_upper = np.array(state["wear_upper"], dtype=float)
+        self.wear_lower = np.array(state["wear_lower"], dtype=float)
+        self._p_load = np.array(state["p_load"], dtype=float)
+        self._cycle = int(state["cycle"])
+        self._done = int(state["done"])
+        self._observe_pending = bool(state["observe_pending"])
+        self._last_per = dict(state["last_per"])
+        self._wall = float(state["wall_time_s"])
         self._apply_geometry()
-        first = self.solver.solve_increment(0.0)  # normal loading at offset 0
-        self._p_load = first.pressure + getattr(self.solver, "debris_pressure", 0.0)
-        hist.debris = self.debris
+        self.solver.load_state_dict(state["solver"])  # type: ignore[attr-defined]
+        self.criterion.set_state(state["criterion"])
         if self.strategy is not None:
-            self.strategy.observe(0, self._state())
-        c = 0
+            vars(self.strategy).update(state["strategy"])
+        if self.debris is not None:
+            vars(self.debris).update(state["debris"])
+        self.de_phases = list(state["de_phases"])
+        hist = self._new_history()
+        hist.rows = list(state["rows"])
+        hist.profiles_upper = list(state["profiles_upper"])
+        hist.profiles_lower = list(state["profiles_lower"])
+        hist.cycles_simulated = int(state["cycles_simulated"])
+        hist.cycles_jumped = int(state["cycles_jumped"])
+        hist.wall_time_s = self._wall
+        hist.de_phases = self.de_phases
+        self.history = hist
+
+    def run(
+        self,
+        cycles: int,
+        progress: Callable[[dict[str, Any]], None] | None = None,
+        checkpoint: Callable[[FrettingLoop], None] | None = None,
+        checkpoint_every: int = 1,
+    ) -> FrettingHistory:
+        """Run up to cycle ``cycles`` (simulated or jumped) and return the history.
+
+        The first call loads the bodies (normal loading at offset 0); a loop restored by
+        :meth:`load_state_dict` (or run before) continues from where it is. ``progress`` is
+        called with each recorded row; ``checkpoint(self)`` after every ``checkpoint_every``
+        simulated cycles (each with the jump that may follow it) and at the end. A contact
+        that outgrows the solver window stops the run early (``history.stopped`` says why;
+        rows so far are kept; no checkpoint is written for the unfinished cycle).
+        """
+        if int(cycles) != cycles or cycles < 1:
+            raise ValueError(f"cycles = {cycles!r} is not allowed: must be an integer >= 1")
+        if int(checkpoint_every) != checkpoint_every or checkpoint_every < 1:
+            raise ValueError(f"checkpoint_every = {checkpoint_every!r} is not allowed: must "
+                             "be an integer >= 1")
+        t0 = time.perf_counter()
+        cycles = int(cycles)
+        if self.history is None:
+            self.history = self._new_history()
+            self.solver.reset()
+            self._apply_geometry()
+            try:
+                first = self.solver.solve_increment(0.0)  # normal loading at offset 0
+            except WindowTooSmallError as err:
+                self.history.stopped = f"first loading: {err}"
+                return self._finish(t0)
+            self._p_load = first.pressure + getattr(self.solver, "debris_pressure", 0.0)
+            if self.strategy is not None:
+                self.strategy.observe(0, self._state())
+        hist = self.history
+        if cycles < self._done:
+            raise ValueError(f"cycles = {cycles}: this run is already at cycle {self._done}")
+        hist.stopped = None
+        c = self._done
+        if self._observe_pending and c < cycles:  # a finished run extended
+            self._observe_pending = False
+            c = self._done = self._jump(c, cycles, self._last_per, progress)
+        since = 0
         while c < cycles:
             try:
                 per = self.simulate_cycle()
@@ -332,32 +471,28 @@ class FrettingLoop:
                 break
             c += 1
             hist.cycles_simulated += 1
-            record(self._row(c, False, per))
-            if self.strategy is None or c >= cycles:
-                continue
-            self.strategy.observe(c, self._state())
-            n = min(int(self.strategy.propose_jump()), cycles - c)
-            if n <= 0:
-                continue
-            old = self._state()
-            new = np.asarray(self.strategy.extrapolate(old, n), dtype=float)
-            new = np.maximum(new, old)  # wear never heals
-            for k in range(1, n + 1):
-                prev = self._state()
-                self._set_state(old + (new - old) * (k / n))
-                self._cycle += 1
-                if self.debris is not None:
-                    dd = self._state() - prev
-                    ku = self.wear_upper.size
-                    self._generate_debris(dd[:ku].reshape(self.wear_upper.shape),
-                                          dd[ku:].reshape(self.wear_lower.shape))
-                    per = per | {"debris_particles": self.debris.n, "de_phase": 0}
-                record(self._row(c + k, True, per))
-            c += n
-            hist.cycles_jumped += n
+            self._record(self._row(c, False, per), progress)
+            self._last_per = per
+            if self.strategy is not None:
+                if c >= cycles:
+                    self._observe_pending = True
+                else:
+                    c = self._jump(c, cycles, per, progress)
+            self._done = c
+            since += 1
+            if checkpoint is not None and (since >= checkpoint_every or c >= cycles):
+                hist.wall_time_s = self._wall + time.perf_counter() - t0
+                checkpoint(self)
+                since = 0
+        return self._finish(t0)
+
+    def _finish(self, t0: float) -> FrettingHistory:
+        hist = self.history
+        assert hist is not None
         self._apply_geometry()  # the solver holds the final worn surfaces
         hist.wear_upper, hist.wear_lower = self.wear_upper, self.wear_lower
         hist.criterion_info = self.criterion.info()
         hist.de_phases = self.de_phases
-        hist.wall_time_s = time.perf_counter() - t0
+        hist.wall_time_s = self._wall + time.perf_counter() - t0
+        self._wall = hist.wall_time_s
         return hist

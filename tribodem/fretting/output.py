@@ -2,19 +2,34 @@
 
 from __future__ import annotations
 
+import json
+import pickle
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from tribodem.fretting.loop import DEBRIS_COLUMNS, RESULT_COLUMNS, FrettingHistory
+from tribodem.io.config import ConfigError
 from tribodem.io.results import atomic_write, write_csv, write_figure, write_json
+
+#: File name of a fretting run's checkpoint in its output folder.
+CHECKPOINT = "checkpoint.npz"
+#: Layout version of :data:`CHECKPOINT` (refused on resume when different).
+CHECKPOINT_FORMAT = 1
+
+
+def write_rows(hist: FrettingHistory, out: Path) -> Path:
+    """``out/results.csv``: one row per cycle recorded so far (rewritten atomically)."""
+    cols = RESULT_COLUMNS + (DEBRIS_COLUMNS if hist.debris is not None else ())
+    return write_csv(out / "results.csv", cols,
+                     ([r.get(c, "") for c in cols] for r in hist.rows))
 
 
 def write_results(hist: FrettingHistory, out: Path, extra: dict[str, Any]) -> dict[str, Any]:
     """``out/results.csv`` (one row per cycle) and ``out/summary.json`` (totals + ``extra``)."""
-    cols = RESULT_COLUMNS + (DEBRIS_COLUMNS if hist.debris is not None else ())
-    write_csv(out / "results.csv", cols, ([r.get(c, "") for c in cols] for r in hist.rows))
+    write_rows(hist, out)
     summary = {**hist.summary(), **extra}
     write_json(out / "summary.json", summary)
     return summary
@@ -186,3 +201,60 @@ def write_debris_outputs(hist: FrettingHistory, out: Path, figures: bool = True,
     fig.tight_layout()
     paths.append(write_figure(out / "debris_pressure.png", fig))
     return paths
+
+
+# ----------------------------------------------------------------------- checkpoints
+@dataclass(frozen=True)
+class _ArrayRef:
+    key: str
+
+
+def _split(tree: Any, arrays: dict[str, np.ndarray]) -> Any:
+    """Numeric numpy arrays of nested dicts -> ``arrays`` (replaced by references)."""
+    if isinstance(tree, dict):
+        return {k: _split(v, arrays) for k, v in tree.items()}
+    if isinstance(tree, np.ndarray) and tree.dtype != object:
+        key = f"a{len(arrays)}"
+        arrays[key] = tree
+        return _ArrayRef(key)
+    return tree
+
+
+def _join(tree: Any, arrays: Any) -> Any:
+    if isinstance(tree, dict):
+        return {k: _join(v, arrays) for k, v in tree.items()}
+    if isinstance(tree, _ArrayRef):
+        return np.array(arrays[tree.key])
+    return tree
+
+
+def write_checkpoint(path: Path, meta: dict[str, Any], state: dict[str, Any]) -> Path:
+    """One ``.npz`` (written to a temporary file, then renamed over ``path``): ``meta``
+    as JSON (format, resolved config, cycle reached), the numeric arrays of ``state``
+    (exact bits) and the rest of ``state`` (rows, strategy, debris record, ...) pickled."""
+    arrays: dict[str, np.ndarray] = {}
+    rest = _split(state, arrays)
+    blob = np.frombuffer(pickle.dumps(rest, protocol=pickle.HIGHEST_PROTOCOL), dtype=np.uint8)
+    head = np.array(json.dumps({"format": CHECKPOINT_FORMAT, **meta}))
+
+    def w(p: Path) -> None:
+        with p.open("wb") as fh:
+            np.savez(fh, meta=head, blob=blob, **arrays)
+    return atomic_write(path, w)
+
+
+def read_checkpoint(path: Path) -> tuple[dict[str, Any], dict[str, Any]]:
+    """(meta, state) of :func:`write_checkpoint`; ``ConfigError`` when it cannot be read."""
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            meta = json.loads(str(z["meta"][()]))
+            if not isinstance(meta, dict) or meta.get("format") != CHECKPOINT_FORMAT:
+                got = meta.get("format") if isinstance(meta, dict) else None
+                raise ValueError(f"checkpoint format {got!r}, this tribodem reads "
+                                 f"{CHECKPOINT_FORMAT}")
+            rest = pickle.loads(z["blob"].tobytes())  # noqa: S301 - the run's own file
+            state = _join(rest, z)
+    except Exception as err:  # noqa: BLE001 - truncated, corrupt or foreign file
+        raise ConfigError(f"checkpoint '{path}' cannot be read: {type(err).__name__}: "
+                          f"{err}") from None
+    return meta, state

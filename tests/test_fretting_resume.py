@@ -1,0 +1,261 @@
+"""``tribodem fretting run`` is resumable and honest (issue 11), through the installed command.
+
+A run killed (SIGKILL) or interrupted (Ctrl-C) at a random point and continued with
+``--resume`` writes the same results.csv and summary.json numbers as an uninterrupted run
+(bitwise; only wall-clock timings differ); so do resumed runs with cycle-jumping and with
+the debris third body. Bad inputs are refused before any output is written; a checkpoint
+made with another config is refused without touching the outputs; an early stop exits 3
+with everything so far written.
+"""
+
+from __future__ import annotations
+
+import json
+import random
+import signal
+import subprocess
+import time
+from pathlib import Path
+
+import pytest
+from conftest import run_tribodem, tribodem_exe
+
+from tribodem.fretting.cli import resolve_config, run_fretting
+from tribodem.io.config import merge
+from tribodem.io.runs import RunStopped
+
+SMALL = "[output]\nfigures = false\nvtk = false\n"
+CYCLES = "30"
+TIMING = {"wall_time_s", "wall_time_total_s"}
+
+
+def _numbers(d):  # noqa: ANN001, ANN202 - JSON tree without wall-clock timings
+    if isinstance(d, dict):
+        return {k: _numbers(v) for k, v in d.items() if k not in TIMING}
+    if isinstance(d, list):
+        return [_numbers(v) for v in d]
+    return d
+
+
+def _same_outputs(a: Path, b: Path) -> None:
+    assert (a / "results.csv").read_bytes() == (b / "results.csv").read_bytes()
+    sa = json.loads((a / "summary.json").read_text())
+    sb = json.loads((b / "summary.json").read_text())
+    assert _numbers(sa) == _numbers(sb)
+    assert (a / "config.toml").read_bytes() == (b / "config.toml").read_bytes()
+
+
+def _args(cfg: Path, out: Path, *extra: str) -> list[str]:
+    return ["fretting", "run", "--quick", "--config", str(cfg), "--cycles", CYCLES,
+            "--no-progress", "--out", str(out), *extra]
+
+
+@pytest.fixture(scope="module")
+def small_cfg(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    p = tmp_path_factory.mktemp("cfg") / "small.toml"
+    p.write_text(SMALL)
+    return p
+
+
+@pytest.fixture(scope="module")
+def reference(small_cfg: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """An uninterrupted run."""
+    out = tmp_path_factory.mktemp("ref") / "run"
+    r = run_tribodem(*_args(small_cfg, out), timeout=120)
+    assert r.returncode == 0, r.stderr
+    assert len((out / "results.csv").read_text().splitlines()) == int(CYCLES) + 1
+    return out
+
+
+def _start_and_signal(args: list[str], out: Path, sig: int) -> subprocess.CompletedProcess:
+    """Start a run, wait for its first checkpoint, wait a random short time, send ``sig``."""
+    # SIGINT as from a terminal: a shell starting background jobs may leave it ignored (and
+    # Python then keeps it ignored), so the child gets the default disposition back
+    proc = subprocess.Popen([tribodem_exe(), *args], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    ck = out / "checkpoint.npz"
+    t_end = time.monotonic() + 90
+    while not ck.exists() and proc.poll() is None and time.monotonic() < t_end:
+        time.sleep(0.02)
+    assert ck.exists(), "no checkpoint was written"
+    time.sleep(random.uniform(0.0, 0.5))
+    proc.send_signal(sig)
+    stdout, stderr = proc.communicate(timeout=60)
+    return subprocess.CompletedProcess(proc.args, proc.returncode, stdout, stderr)
+
+
+def test_kill_9_then_resume_equals_uninterrupted(small_cfg: Path, reference: Path,
+                                                 tmp_path: Path) -> None:
+    out = tmp_path / "run"
+    r = _start_and_signal(_args(small_cfg, out), out, signal.SIGKILL)
+    assert r.returncode in (-signal.SIGKILL, 0)  # 0: it finished before the kill
+    done = len((out / "results.csv").read_text().splitlines()) - 1
+    assert 1 <= done <= int(CYCLES)
+    r = run_tribodem(*_args(small_cfg, out, "--resume"), timeout=120)
+    assert r.returncode == 0, r.stderr
+    _same_outputs(reference, out)
+
+
+def test_ctrl_c_exits_130_naming_outputs_then_resume_equals(small_cfg: Path, reference: Path,
+                                                            tmp_path: Path) -> None:
+    out = tmp_path / "run"
+    r = _start_and_signal(_args(small_cfg, out), out, signal.SIGINT)
+    if r.returncode == 0:  # finished before the signal arrived: nothing to check there
+        pytest.skip("the run finished before Ctrl-C")
+    assert r.returncode == 130, r.stderr
+    assert "Traceback" not in r.stderr, r.stderr
+    assert str(out) in r.stderr and "checkpoint" in r.stderr and "--resume" in r.stderr
+    r = run_tribodem(*_args(small_cfg, out, "--resume"), timeout=120)
+    assert r.returncode == 0, r.stderr
+    _same_outputs(reference, out)
+
+
+def _in_process(tmp: Path, monkeypatch: pytest.MonkeyPatch, name: str, cycles: int,
+                extra: dict, stop_after: int) -> None:
+    """Uninterrupted vs interrupted (Ctrl-C raised right after the ``stop_after``-th
+    checkpoint, so the rest of that cycle's work is lost) and resumed (Python API)."""
+    import tribodem.fretting.cli as fcli
+
+    ov = merge({"output": {"figures": False, "vtk": True}}, extra)
+    cfg = resolve_config(None, quick=True, overrides=merge(ov, {"cycles": cycles}))
+    run_fretting(cfg, tmp / f"{name}_a")
+    real, calls = fcli.write_checkpoint, []
+
+    def interrupted(*args, **kw):  # noqa: ANN002, ANN003, ANN202
+        real(*args, **kw)
+        calls.append(1)
+        if len(calls) == stop_after:
+            raise KeyboardInterrupt
+
+    monkeypatch.setattr(fcli, "write_checkpoint", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        run_fretting(cfg, tmp / f"{name}_b")
+    monkeypatch.undo()
+    run_fretting(cfg, tmp / f"{name}_b", resume=True)
+    _same_outputs(tmp / f"{name}_a", tmp / f"{name}_b")
+    for f in ("surface_upper.vtu", "surface_lower.vtu"):  # the wear maps
+        assert (tmp / f"{name}_a" / f).read_bytes() == (tmp / f"{name}_b" / f).read_bytes()
+
+
+@pytest.mark.parametrize(("jump", "cycles", "stop_after"), [
+    ({"strategy": "constant", "params": {"jump_length": 3}}, 12, 2),
+    ({"strategy": "adaptive", "params": {"foundation_cycles": 4, "max_jump_initial": 4}},
+     20, 5),
+])
+def test_resume_with_jumping_equals_uninterrupted(tmp_path: Path,
+                                                  monkeypatch: pytest.MonkeyPatch,
+                                                  jump: dict, cycles: int,
+                                                  stop_after: int) -> None:
+    _in_process(tmp_path, monkeypatch, "jump", cycles, {"jump": jump}, stop_after)
+    rows = (tmp_path / "jump_a" / "results.csv").read_text().splitlines()[1:]
+    assert any(r.split(",")[1] == "1" for r in rows), "no cycle was jumped"
+
+
+def test_resume_with_debris_equals_uninterrupted(tmp_path: Path,
+                                                 monkeypatch: pytest.MonkeyPatch) -> None:
+    # 2.5 um particles (about 150, not 10,000) and short DE phases keep it to seconds; a DE
+    # phase before the stop (cycle 2) and one after it (cycle 4)
+    debris = {"every": 2, "diameter": 2.5e-6, "max_steps": 3000, "ramp_steps": 1000}
+    _in_process(tmp_path, monkeypatch, "debris", 5, {"debris": debris}, 3)
+    s = json.loads((tmp_path / "debris_a" / "summary.json").read_text())
+    assert len(s["debris"]["de_phases"]) == 2
+
+
+def test_config_round_trip_and_finished_resume(small_cfg: Path, tmp_path: Path) -> None:
+    a, b = tmp_path / "a", tmp_path / "b"
+    r = run_tribodem("fretting", "run", "--quick", "--config", str(small_cfg), "--cycles", "2",
+                     "--jump", "constant", "--no-progress", "--out", str(a), timeout=120)
+    assert r.returncode == 0, r.stderr
+    text = (a / "config.toml").read_text()
+    assert "none" not in text.replace('strategy = "none"', "")  # None fields left out
+    r = run_tribodem("fretting", "run", "--config", str(a / "config.toml"), "--no-progress",
+                     "--out", str(b), timeout=120)
+    assert r.returncode == 0, r.stderr
+    assert (a / "config.toml").read_bytes() == (b / "config.toml").read_bytes()
+    _same_outputs(a, b)
+    before = (a / "results.csv").read_bytes()
+    r = run_tribodem("fretting", "run", "--out", str(a), "--resume", "--no-progress",
+                     timeout=120)  # a finished run: outputs rewritten, same numbers
+    assert r.returncode == 0, r.stderr
+    assert (a / "results.csv").read_bytes() == before
+
+
+#: a window just above the minimum (4 Hertz radii) and a wear rate 100x the seed's: the
+#: worn contact reaches the window edge in cycle 5
+OUTGROWS = {"contact": {"window": 5.4e-4}, "wear": {"alpha": 1e-11}}
+
+
+def test_early_stop_exits_3_with_outputs(tmp_path: Path) -> None:
+    cfg = tmp_path / "stop.toml"
+    cfg.write_text("[contact]\nwindow = 5.4e-4\n[wear]\nalpha = 1e-11\n[output]\nvtk = false\n")
+    out = tmp_path / "run"
+    r = run_tribodem("fretting", "run", "--quick", "--config", str(cfg), "--cycles", "8",
+                     "--no-progress", "--out", str(out), timeout=180)
+    assert r.returncode == 3, r.stderr
+    assert "run stopped" in r.stderr and "window" in r.stderr and str(out) in r.stderr
+    assert "Traceback" not in r.stderr
+    s = json.loads((out / "summary.json").read_text())
+    assert s["stopped"] and s["cycles"] < 8
+    rows = (out / "results.csv").read_text().splitlines()
+    assert len(rows) == s["cycles"] + 1
+    assert (out / "wear_scar.png").stat().st_size > 0
+
+
+def test_window_smaller_than_contact_refused_before_output(tmp_path: Path) -> None:
+    cfg = tmp_path / "w.toml"
+    cfg.write_text("[contact]\nwindow = 2e-4\n")
+    out = tmp_path / "new"
+    r = run_tribodem("fretting", "run", "--config", str(cfg), "--out", str(out), timeout=120)
+    assert r.returncode == 2, r.stderr
+    assert "contact.window" in r.stderr and "0.0002" in r.stderr and "allowed: >=" in r.stderr
+    assert "Traceback" not in r.stderr
+    assert not out.exists()
+
+
+def test_unknown_jump_param_refused(tmp_path: Path) -> None:
+    cfg = tmp_path / "j.toml"
+    cfg.write_text("[jump]\nstrategy = 'adaptive'\n[jump.params]\nq_why = 3\n")
+    out = tmp_path / "new"
+    r = run_tribodem("fretting", "run", "--config", str(cfg), "--out", str(out), timeout=120)
+    assert r.returncode == 2, r.stderr
+    assert "q_why" in r.stderr and "q_y" in r.stderr and "foundation_cycles" in r.stderr
+    assert not out.exists()
+
+
+def test_mismatched_or_corrupt_checkpoint_refused_outputs_untouched(small_cfg: Path,
+                                                                    tmp_path: Path) -> None:
+    out = tmp_path / "run"
+    r = run_tribodem("fretting", "run", "--quick", "--config", str(small_cfg), "--cycles", "2",
+                     "--no-progress", "--out", str(out), timeout=120)
+    assert r.returncode == 0, r.stderr
+
+    def snapshot() -> dict[str, tuple[bytes, int]]:
+        return {p.name: (p.read_bytes(), p.stat().st_mtime_ns) for p in out.iterdir()}
+
+    before = snapshot()
+    r = run_tribodem("fretting", "run", "--quick", "--config", str(small_cfg), "--cycles", "4",
+                     "--criterion", "archard", "--no-progress", "--out", str(out), "--resume",
+                     timeout=120)
+    assert r.returncode == 2, r.stderr
+    assert "wear.criterion = 'archard'" in r.stderr and "'energy'" in r.stderr
+    assert snapshot() == before
+    r = run_tribodem("fretting", "run", "--quick", "--config", str(small_cfg), "--cycles", "1",
+                     "--no-progress", "--out", str(out), "--resume", timeout=120)
+    assert r.returncode == 2 and "cycles = 1" in r.stderr, r.stderr
+    assert snapshot() == before
+    ck = out / "checkpoint.npz"
+    ck.write_bytes(ck.read_bytes()[: ck.stat().st_size // 2])
+    before = snapshot()
+    r = run_tribodem("fretting", "run", "--out", str(out), "--resume", timeout=120)
+    assert r.returncode == 2, r.stderr
+    assert f"checkpoint '{ck}' cannot be read" in r.stderr and "Traceback" not in r.stderr
+    assert snapshot() == before
+
+
+def test_python_api_early_stop_raises_run_stopped(tmp_path: Path) -> None:
+    cfg = resolve_config(None, quick=True, overrides=merge(OUTGROWS, {
+        "cycles": 8, "output": {"figures": False, "vtk": False}}))
+    with pytest.raises(RunStopped, match="window"):
+        run_fretting(cfg, tmp_path / "run")
+    assert json.loads((tmp_path / "run" / "summary.json").read_text())["stopped"]
