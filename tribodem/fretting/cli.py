@@ -433,6 +433,8 @@ def run_fretting(cfg: FrettingConfig, out: Path, echo: Any = None, resume: bool 
     }
     summary = write_results(hist, out, extra)
     if hist.stopped:
+        runs.announce(out, ck, resume_hint="a resume would stop at the same cycle: to go on, "
+                      "start a new run with a larger contact.window")
         raise runs.RunStopped(f"{hist.stopped} (results.csv, summary.json and figures up "
                               f"to cycle {loop.cycles_done} are written)")
     return summary
