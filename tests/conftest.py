@@ -44,3 +44,11 @@ def run_tribodem(*args: str, timeout: float = 600, **kw):  # noqa: ANN201
 
     return subprocess.run([tribodem_exe(), *args], capture_output=True, text=True,
                           timeout=timeout, **kw)
+
+
+def default_sigint() -> None:
+    """``preexec_fn`` for a child that must take Ctrl-C: a shell without job control starts
+    background commands with SIGINT ignored, and Python keeps an inherited SIG_IGN."""
+    import signal
+
+    signal.signal(signal.SIGINT, signal.SIG_DFL)

@@ -13,7 +13,7 @@ import time
 from pathlib import Path
 
 import pytest
-from conftest import run_tribodem, tribodem_exe
+from conftest import default_sigint, run_tribodem, tribodem_exe
 
 #: a tiny interface (~150 particles), ~17k steps per microsecond of sliding
 SMALL = """
@@ -68,7 +68,7 @@ def _snapshot(folder: Path) -> dict[str, tuple[bytes, int]]:
 
 def _start(*args: str) -> subprocess.Popen:
     return subprocess.Popen([tribodem_exe(), *args], stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True)
+                            stderr=subprocess.PIPE, text=True, preexec_fn=default_sigint)
 
 
 def _wait_for(path: Path, proc: subprocess.Popen, timeout: float = 60.0) -> None:
@@ -280,7 +280,7 @@ def test_sweep_reports_a_failed_member_and_compares_the_rest(tmp_path: Path) -> 
     assert r.returncode == 3 and "Traceback" not in r.stderr
     assert "condition 3" in r.stderr and "1 of 5 sweep members failed" in r.stderr
     md = (out / "comparison.md").read_text()
-    assert "## Failed members" in md and "condition 3 seed 0" in md
+    assert "## Failed members" in md and "condition 3 packing 0" in md
     assert "not evaluated: no run of condition 3" in md
     for k in (1, 2, 4, 5):
         assert json.loads((out / f"condition_{k}" / "summary.json").read_text())[

@@ -15,7 +15,7 @@ import time
 from pathlib import Path
 
 import pytest
-from conftest import run_tribodem, tribodem_exe
+from conftest import default_sigint, run_tribodem, tribodem_exe
 
 CONFIG = """[case]
 particles = 300
@@ -60,7 +60,7 @@ def _start_and_stop(cfg: Path, out: Path, sig: int, rng: random.Random
     """Start a run, wait for its first checkpoint, stop it with ``sig`` a little later."""
     p = subprocess.Popen([tribodem_exe(), "dem", "run", "--config", str(cfg), "--out",
                           str(out), "--no-progress"], stdout=subprocess.PIPE,
-                         stderr=subprocess.PIPE, text=True)
+                         stderr=subprocess.PIPE, text=True, preexec_fn=default_sigint)
     t0 = time.monotonic()
     while not (out / "checkpoint.npz").exists():
         assert p.poll() is None, p.communicate()
