@@ -95,10 +95,12 @@ def _error_text(log: str) -> str:
         if "*ERROR" in ln:
             para = [ln.strip()]
             for nxt in lines[i + 1:i + 6]:
-                if not nxt.strip():
+                if not nxt.strip() or "*ERROR" in nxt:
                     break
                 para.append(nxt.strip())
-            out.append(" ".join(para))
+            text = " ".join(para)
+            if text not in out:
+                out.append(text)
     return " | ".join(out)
 
 
@@ -129,7 +131,8 @@ def run_ccx(deck: str | Path, threads: int = 1, timeout: float = 600.0,
     log = log_path.read_text(errors="replace")
     err = _error_text(log)
     if rc != 0 or err or "Job finished" not in log:
-        message = err or f"exit code {rc}, no 'Job finished' in {log_path}"
+        tail = " | ".join(ln.strip() for ln in log.splitlines() if ln.strip())[-300:]
+        message = err or f"exit code {rc}, no 'Job finished' in {log_path}; log ends: {tail}"
         cls = CcxConvergenceError if any(w in message.lower() for w in _CONVERGENCE_WORDS) \
             else CcxError
         raise cls(f"ccx failed (exit code {rc})", message, deck, _last_sta_line(job))

@@ -75,6 +75,7 @@ class ContactSettings:
     #: the normal loading; for elastically similar bodies, Dundurs beta = 0, the normal
     #: problem does not depend on friction)
     mu_loading: float = 1e-3
+    stick_factor_loading: float = 0.1  #: stick slope factor while seating and loading
 
 
 @dataclass(frozen=True)
@@ -145,11 +146,13 @@ def _model_data(out: io.StringIO, mesh: Mesh, lower: FEMaterial, upper: FEMateri
 
 
 def _change_friction(out: io.StringIO, mesh: Mesh, lower: FEMaterial, upper: FEMaterial,
-                     contact: ContactSettings, mu: float) -> None:
+                     contact: ContactSettings, loading: bool) -> None:
     if contact.mu > 0:
         k_n = contact.penalty_factor * min(lower.young, upper.young) / mesh.h_fine
+        mu = contact.mu_loading if loading else contact.mu
+        factor = contact.stick_factor_loading if loading else contact.stick_factor
         out.write("*CHANGE FRICTION, INTERACTION=SI\n")
-        out.write(f"*FRICTION\n{mu}, {_fmt(contact.stick_factor * k_n)}\n")
+        out.write(f"*FRICTION\n{mu}, {_fmt(factor * k_n)}\n")
     out.write(f"*CONTACT PAIR, INTERACTION=SI, TYPE={contact.formulation}\nSPAD, SFLAT\n")
 
 
@@ -207,7 +210,7 @@ def write_deck(path: str | Path, mesh: Mesh, case: LoadCase,
     out.write("*BOUNDARY\nLBOT, 1, 2\n")
     # step 1: seating under displacement control
     out.write("*STEP, INC=200\n*STATIC\n0.5, 1., 1e-4, 0.5\n")
-    _change_friction(out, mesh, lower, upper, contact, contact.mu_loading)
+    _change_friction(out, mesh, lower, upper, contact, loading=True)
     out.write(f"*BOUNDARY\n{ref}, 1, 1, 0.\n{ref}, 2, 2, {_fmt(-seat)}\n")
     _outputs(out, plastic, fine_stress, frd, "")
     out.write("*END STEP\n")
@@ -222,7 +225,7 @@ def write_deck(path: str | Path, mesh: Mesh, case: LoadCase,
     if case.delta > 0:
         dt = 4.0 / n
         out.write(f"*STEP, INC=10000\n*STATIC\n{dt}, {total}, {dt * 1e-4}, {dt}\n")
-        _change_friction(out, mesh, lower, upper, contact, contact.mu)
+        _change_friction(out, mesh, lower, upper, contact, loading=False)
         out.write(f"*BOUNDARY, AMPLITUDE=STROKE\n{ref}, 1, 1, {_fmt(case.delta)}\n")
         _outputs(out, plastic, fine_stress, frd, "TCYCLE")
         out.write("*END STEP\n")

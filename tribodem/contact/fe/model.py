@@ -31,7 +31,7 @@ class LineCase:
     n_increments: int = 16  #: increments of a full cycle (multiple of 4)
     half_cycle: bool = False  #: only 0 -> +delta
     h_over_a: float = DEFAULT_H_OVER_A  #: element size at the contact / Hertz half-width
-    size_factor: float = 20.0  #: body half-width and height / a
+    size_factor: float = 40.0  #: body half-width and height / a (pad half-width <= 0.4 R)
     growth: float = 1.2  #: element size ratio outside the fine zone
     lower: FEMaterial = field(default_factory=FEMaterial)
     upper: FEMaterial = field(default_factory=FEMaterial)

@@ -17,11 +17,13 @@ References (K. L. Johnson, Contact Mechanics, 1985; seed 003 section 3.2.5):
 * Gross slip: Q = mu P.
 * First yield (von Mises, nu = 0.3, table 4.1 / section 4.2): max sigma_vM = p0 / 1.79 at
   z = 0.70 a: compared p0 / max sigma_vM (integration points of the flat's fine zone, elastic
-  run) and the depth of the maximum.
+  run), the depth of the maximum, and p0 / Y at the onset of plastic strain in an
+  elastic-plastic run (bilinear EN24T, seed table 5.1).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from pathlib import Path
 from typing import Any
@@ -30,6 +32,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import brentq
 
+from tribodem.contact.fe.deck import FEMaterial
 from tribodem.contact.fe.model import LineCase, LineRun, run_line_case
 from tribodem.contact.fe.results import ContactState, ip_coordinates
 
@@ -160,15 +163,57 @@ def tangential_checks(run: LineRun, ratios: tuple[float, ...] = (0.35, 0.55, 0.7
     return out
 
 
+def plastic_onset_case(h_over_a: float | None = None) -> LineCase:
+    """EN24T with bilinear hardening (Y 680 MPa) loaded to 1.15 x Johnson's first-yield load
+    P_y = pi R (1.79 Y)^2 / E* in 20 increments, no tangential step."""
+    mat = FEMaterial(yield_strength=680e6)
+    kw: dict[str, Any] = {} if h_over_a is None else {"h_over_a": h_over_a}
+    probe = LineCase(lower=mat, upper=mat, **kw)
+    p_y = math.pi * probe.radius * (YIELD_FACTOR * 680e6) ** 2 / probe.e_star
+    return dataclasses.replace(probe, load=1.15 * p_y, load_increments=20)
+
+
+def plastic_onset_check(run: LineRun) -> list[dict[str, Any]]:
+    """Hertz p0 / Y at the onset of plastic strain (PEEQ > 0 anywhere in the fine zones):
+    linear extrapolation to zero of the peak PEEQ of the first two plastic increments, kept
+    inside the bracket (last elastic, first plastic increment); reference 1.79, 5 %."""
+    case, res = run.case, run.results
+    y = float(case.lower.yield_strength or 0.0)
+    k_load = [k for k, t in enumerate(res.times) if 1.0 + 1e-9 < t <= 2.0 + 1e-9]
+    p0 = np.array([math.sqrt(res.normal_force[k] * case.e_star / (math.pi * case.radius))
+                   for k in k_load])
+    peeq = np.array([res.peeq(float(res.times[k]))[1].max() for k in k_load])
+    plastic = np.flatnonzero(peeq > 0.0)
+    if plastic.size < 2 or plastic[0] == 0:
+        value = float("nan") if plastic.size == 0 else float(p0[plastic[0]])
+    else:
+        i = int(plastic[0])
+        slope = (peeq[i + 1] - peeq[i]) / (p0[i + 1] - p0[i])
+        value = float(np.clip(p0[i] - peeq[i] / slope, p0[i - 1], p0[i]))
+    out = check("plastic_onset_p0_over_Y", value / y, YIELD_FACTOR, 0.05)
+    if not math.isfinite(value):
+        out["pass"] = False
+    return [out]
+
+
 def default_case(h_over_a: float | None = None) -> LineCase:
     """The validation case: EN24T pad R 4 mm on a flat, 100 N/mm (p0 1.02 GPa < 1.79 Y:
-    elastic), stroke 3 um in 10 increments (about 1.8 x the gross-slip displacement)."""
+    elastic), bodies 2 x 40 a wide and 40 a high, stroke 3 um in 10 increments (gross slip
+    from about 2 um)."""
     kw: dict[str, Any] = {} if h_over_a is None else {"h_over_a": h_over_a}
     return LineCase(load=1e5, delta=3e-6, n_increments=40, half_cycle=True, **kw)
 
 
 def validate_fe(folder: str | Path, threads: int = 1, timeout: float = 900.0,
-                h_over_a: float | None = None) -> list[dict[str, Any]]:
-    """Run :func:`default_case` in ``folder`` and return every check."""
-    run = run_line_case(default_case(h_over_a), folder, threads=threads, timeout=timeout)
-    return hertz_checks(run) + yield_checks(run) + tangential_checks(run)
+                h_over_a: float | None = None, plastic: bool = True) -> list[dict[str, Any]]:
+    """Run :func:`default_case` (and :func:`plastic_onset_case`) in sub-folders ``elastic``
+    (and ``plastic``) of ``folder``; return every check."""
+    folder = Path(folder)
+    run = run_line_case(default_case(h_over_a), folder / "elastic", threads=threads,
+                        timeout=timeout)
+    out = hertz_checks(run) + yield_checks(run) + tangential_checks(run)
+    if plastic:
+        prun = run_line_case(plastic_onset_case(h_over_a), folder / "plastic", threads=threads,
+                             timeout=timeout)
+        out += plastic_onset_check(prun)
+    return out
