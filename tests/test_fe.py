@@ -217,3 +217,20 @@ def test_timeout_kills_ccx(tmp_path: Path) -> None:
     _, deck = build(coarse_case(), tmp_path, fine_stress=False)
     with pytest.raises(CcxTimeoutError, match="wall-clock limit"):
         run_ccx(deck, timeout=0.5)
+
+
+@needs_ccx
+def test_validate_fe_all_checks_pass(tmp_path: Path) -> None:
+    """The ``tribodem validate --solver fe`` checks at the default mesh (h = a / 8)."""
+    from tribodem.contact.fe.validate import validate_fe
+
+    checks = validate_fe(tmp_path, threads=2, timeout=600)
+    names = [c["name"] for c in checks]
+    for prefix in ("hertz_p0", "hertz_a", "first_yield_p0_over_vm", "gross_slip_Q_over_muP",
+                   "mindlin_c", "Q(delta", "slip_displacement", "plastic_onset_p0_over_Y"):
+        assert any(n.startswith(prefix) for n in names), prefix
+    assert sum(n.startswith("mindlin_c") for n in names) == 3
+    failed = [c for c in checks if not c["pass"]]
+    assert not failed, failed
+    assert all(set(c) == {"name", "value", "reference", "error", "tolerance", "pass"}
+               for c in checks)
