@@ -34,8 +34,12 @@ def test_energy_volume_equals_alpha_times_dissipated_energy():
     e = h.cumulative_energy
     # gross slip: the interface dissipates mu P 4A per cycle (independent check of e)
     assert e == pytest.approx(4 * MU * LOAD * 4 * AMP, rel=1e-3)
+    # eq 2.7: the total worn volume (both bodies) is alpha x the dissipated energy, shared
+    # equally by default
+    total = h.volume("upper") + h.volume("lower")
+    assert total == pytest.approx(ALPHA_SEED * e, rel=1e-9)
     for body in ("upper", "lower"):
-        assert h.volume(body) == pytest.approx(ALPHA_SEED * e, rel=0.01)
+        assert h.volume(body) == pytest.approx(0.5 * ALPHA_SEED * e, rel=0.01)
         assert h.rows[-1][f"wear_volume_{body}_m3"] == pytest.approx(h.volume(body), rel=1e-12)
     # the worn surfaces are what the solver sees next cycle (geometry update)
     assert loop.solver.upper(np.zeros(1), np.zeros(1))[0] == pytest.approx(
@@ -57,15 +61,15 @@ def _flat(x, y):
 
 
 def test_archard_flat_on_flat_volume_equals_k_p_s():
-    k, amp, cycles = 2e-15, 0.1e-3, 2
+    ku, kl, amp, cycles = 2e-15, 5e-16, 0.1e-3, 2
     solver = HalfSpaceSolver(_punch(0.2e-3), _flat, load=LOAD, n=64, window=1.0e-3)
-    h = FrettingLoop(solver, make_criterion("archard", k=k), amplitude=amp,
+    h = FrettingLoop(solver, make_criterion("archard", k_upper=ku, k_lower=kl), amplitude=amp,
                      n_increments=16).run(cycles)
     s = 4 * amp * cycles  # sliding distance, m
-    for body in ("upper", "lower"):
+    for body, k in (("upper", ku), ("lower", kl)):  # each body: k_body P s
         assert h.volume(body) == pytest.approx(k * LOAD * s, rel=0.01)
     # the lower body's scar spreads over the stroke: shallower than the upper one
-    assert h.wear_lower.max() < h.wear_upper.max()
+    assert h.wear_lower.max() < h.wear_upper.max() * kl / ku
 
 
 @pytest.mark.parametrize("z", [np.linspace(0, 1e-4, 11), np.geomspace(1e-7, 1e-4, 17)])
@@ -100,9 +104,10 @@ def test_shear_criterion_wears_both_bodies_and_reports_grid():
 
 
 def test_unavailable_criteria_refuse_with_reason():
-    crit = make_criterion("dfdi")  # refused at run time by an elastic solver
-    with pytest.raises(CriterionUnavailable, match="plastic strain"):
-        FrettingLoop(HalfSpaceSolver(n=32), crit, n_increments=8).run(1)
+    crit = make_criterion("dfdi")  # refused before any work by an elastic solver
+    with pytest.raises(CriterionUnavailable,
+                       match="'dfdi' needs plastic .the equivalent plastic strain.*HalfSpace"):
+        FrettingLoop(HalfSpaceSolver(n=32), crit, n_increments=8)
     with pytest.raises(ValueError, match="unknown criterion"):
         make_criterion("hardness")
 

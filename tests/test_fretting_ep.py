@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from tribodem.contact import (
+    Capabilities,
     ElastoPlasticSolver,
     HalfSpaceSolver,
     HertzSphere,
@@ -59,20 +60,23 @@ def test_ep_above_yield_caps_pressure_and_yields_below_surface():
     assert cum.max() > 1e-3
     k = np.unravel_index(np.argmax(cum), cum.shape)
     assert st.z[k[0]] > 0.1 * s.a_hertz  # frictionless Hertz: yield starts below the surface
-    steps = s.pop_plastic_steps()
-    assert len(steps) == 1 and steps[0].dp.max() > 1e-3 and s.pop_plastic_steps() == []
+    steps = s.plastic_steps()
+    assert len(steps) == 1 and steps[0].dp.max() > 1e-3 and s.plastic_steps() == []
     # the plastic surface displacement deepens the recession at the centre (flattening)
     up = s.plastic_displacement
     assert up[s.ep_n // 2, s.ep_n // 2] == pytest.approx(up.max(), rel=0.05) and up.max() > 0
 
 
 class _FakePlastic:
-    """Solver stand-in exposing one prescribed plastic load step."""
+    """Solver stand-in exposing one prescribed plastic load step (the contract's plastic
+    part only)."""
+
+    capabilities = Capabilities(plastic=True)
 
     def __init__(self, step: PlasticStep, depth: float) -> None:
-        self.step, self.ep_depth = step, depth
+        self.step, self.plastic_depth = step, depth
 
-    def pop_plastic_steps(self) -> list[PlasticStep]:
+    def plastic_steps(self) -> list[PlasticStep]:
         s, self.step = self.step, None
         return [s] if s is not None else []
 
@@ -110,7 +114,7 @@ def test_dfdi_failure_strain_and_column_depth():
 
 def test_dfdi_refused_by_elastic_solver():
     with pytest.raises(ValueError, match="plastic strain"):
-        DFDICriterion.check_solver(HalfSpaceSolver(n=32))
+        DFDICriterion().check_solver(HalfSpaceSolver(n=32))
 
 
 def test_swt_life_inverts_eq_6_3():

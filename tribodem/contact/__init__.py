@@ -1,21 +1,27 @@
 """First-body contact solvers (DESIGN.md "The fretting FE-DE model"; seed 003 ch. 3, 5, 6).
 
-One interface, :class:`FirstBodySolver`, driven through fretting cycles by
-:class:`FrettingCycle`; backends :class:`HalfSpaceSolver` (elastic half-space BEM on tamaas)
-and :class:`ElastoPlasticSolver` (tamaas EPIC, bilinear EN24T).
+One contract, :class:`FirstBodySolver` with its :class:`Capabilities`, driven through
+fretting cycles by :class:`tribodem.fretting.FrettingLoop`. Backends, registered by name in
+:data:`BACKENDS` (a new backend is one module here plus one line there):
+``elastic`` :class:`HalfSpaceSolver` (elastic half-space BEM on tamaas) and
+``elastic-plastic`` :class:`ElastoPlasticSolver` (tamaas EPIC, bilinear EN24T).
 """
 
 from tribodem.contact.base import (
+    CAPABILITY_TEXT,
     VOIGT_ORDER,
-    CycleResult,
+    Capabilities,
     ElasticBody,
     FirstBodySolver,
-    FrettingCycle,
     IncrementResult,
+    Recession,
     SubsurfaceStress,
+    Unsupported,
+    WindowTooSmallError,
     contact_modulus,
     cycle_offsets,
     dundurs_beta,
+    require,
 )
 from tribodem.contact.elastoplastic import (
     ElastoPlasticSolver,
@@ -30,27 +36,31 @@ from tribodem.contact.geometry import (
     cylinder,
     extruded_profile,
 )
-from tribodem.contact.halfspace import (
-    HalfSpaceSolver,
-    WindowTooSmallError,
-    max_shear,
-    von_mises,
-)
+from tribodem.contact.halfspace import HalfSpaceSolver, max_shear, von_mises
+
+#: First-body backends by name (``solver = "..."`` in a fretting config).
+BACKENDS: dict[str, type[FirstBodySolver]] = {
+    "elastic": HalfSpaceSolver,
+    "elastic-plastic": ElastoPlasticSolver,
+}
 
 __all__ = [
+    "BACKENDS",
+    "CAPABILITY_TEXT",
     "VOIGT_ORDER",
-    "CycleResult",
+    "Capabilities",
     "ElasticBody",
     "ElastoPlasticSolver",
     "FirstBodySolver",
-    "FrettingCycle",
     "HalfSpaceSolver",
     "HeightMap",
     "HertzSphere",
     "IncrementResult",
     "PlasticStep",
     "PlasticSubsurfaceStress",
+    "Recession",
     "SubsurfaceStress",
+    "Unsupported",
     "WindowTooSmallError",
     "bilinear_hardening",
     "contact_modulus",
@@ -60,5 +70,6 @@ __all__ = [
     "dundurs_beta",
     "extruded_profile",
     "max_shear",
+    "require",
     "von_mises",
 ]

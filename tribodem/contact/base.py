@@ -1,4 +1,4 @@
-"""First-body solver interface and the fretting-cycle driver (seed 003, sections 3.3, 6.1).
+"""The first-body contract (seed 003, sections 3.3, 6.1): what every backend gives.
 
 Conventions (SI throughout):
 
@@ -22,11 +22,15 @@ from __future__ import annotations
 
 import math
 from abc import ABC, abstractmethod
-from dataclasses import dataclass, field
-from typing import Literal
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import NDArray
+
+#: A body's recession below its tangent plane at (x, y), m (callable or height map).
+Recession = Callable[[NDArray[np.float64], NDArray[np.float64]], NDArray[np.float64]]
 
 Body = Literal["upper", "lower"]
 BODIES: tuple[Body, ...] = ("upper", "lower")
@@ -117,17 +121,79 @@ class SubsurfaceStress:
     tresca: NDArray[np.float64]  #: maximum shear stress (s1 - s3)/2, Pa, [nz, n, n]
 
 
-class FirstBodySolver(ABC):
-    """One first-body contact solver (DESIGN.md: backend 1 half-space, backend 2 FE).
+@dataclass(frozen=True)
+class Capabilities:
+    """What a first-body backend can give; criteria and the loop check it before any work.
 
-    A solver owns the two surfaces, the materials, the normal load and its grid; a driver
-    asks it for one increment of relative tangential position at a time, in path order (the
-    solver may keep load history between calls).
+    ``plastic``: equivalent plastic strain increments (:meth:`FirstBodySolver.plastic_steps`);
+    ``partial_slip``: stick/slip inside the contact (else gross slip q = mu p everywhere);
+    ``subsurface``: stress below the surface (:meth:`FirstBodySolver.subsurface_stress`);
+    ``debris``: a prescribed extra surface pressure (the debris third body);
+    ``contacts``: the contact geometries it solves (``"point"``, ``"line"``).
     """
 
+    plastic: bool = False
+    partial_slip: bool = False
+    subsurface: bool = True
+    debris: bool = False
+    contacts: tuple[str, ...] = ("point",)
+
+    def names(self) -> set[str]:
+        """The capabilities that hold, by name (``plastic``, ``subsurface``, ...)."""
+        return {k for k in ("plastic", "partial_slip", "subsurface", "debris")
+                if getattr(self, k)} | {f"{c}_contact" for c in self.contacts}
+
+
+#: What each capability name means (for messages).
+CAPABILITY_TEXT = {
+    "plastic": "plastic (the equivalent plastic strain)",
+    "partial_slip": "partial_slip (stick and slip inside the contact)",
+    "subsurface": "subsurface (the stress below the surface)",
+    "debris": "debris (a prescribed debris pressure)",
+    "point_contact": "point_contact",
+    "line_contact": "line_contact (plane strain)",
+}
+
+
+class WindowTooSmallError(RuntimeError):
+    """The contact reaches the edge of the solver's window (the run stops early)."""
+
+
+class Unsupported(NotImplementedError):
+    """A contract method outside the backend's declared capabilities."""
+
+
+class FirstBodySolver(ABC):
+    """One first-body contact solver: the only thing the fretting loop and the criteria use.
+
+    A backend is one module in :mod:`tribodem.contact` plus a line in
+    :data:`tribodem.contact.BACKENDS`. It owns the two surfaces, the materials, the normal
+    load and its grid; the driver sets the worn surfaces, then asks for one increment of
+    relative tangential position at a time, in path order (the solver may keep load history
+    between calls). The contract:
+
+    - data: ``n``, ``dx`` (window grid), ``load`` (N), ``upper``/``lower`` (recessions, m:
+      the surfaces the next solve sees), ``capabilities``;
+    - :meth:`set_surfaces` (worn geometry), :meth:`reset`, :meth:`begin_cycle`,
+      :meth:`solve_increment`;
+    - fields: surface fields in :class:`IncrementResult`; :meth:`subsurface_stress`
+      (capability ``subsurface``); :meth:`plastic_steps` and :attr:`plastic_depth`
+      (``plastic``);
+    - debris (``debris``): :meth:`set_debris_pressure`, :attr:`debris_pressure`,
+      :attr:`debris_load`, :meth:`loaded_solution`;
+    - resume: :meth:`state_dict` / :meth:`load_state_dict`.
+    """
+
+    #: what this backend can give (class attribute of each backend)
+    capabilities: Capabilities = Capabilities()
     #: window grid spacing (m) and number of points per side
     dx: float
     n: int
+    #: normal load, N
+    load: float
+    #: recessions of the two surfaces (m), as the next solve sees them
+    upper: Recession
+    lower: Recession
 
     @property
     def window(self) -> float:
@@ -139,19 +205,78 @@ class FirstBodySolver(ABC):
         """Window point coordinates along x or y relative to the window centre, m."""
         return (np.arange(self.n) - self.n // 2) * self.dx
 
+    def set_surfaces(self, upper: Recession, lower: Recession) -> None:
+        """Give the (worn) surfaces the next increments see (recessions, m)."""
+        self.upper, self.lower = upper, lower
+
     @abstractmethod
     def reset(self) -> None:
         """Forget the load history (start a new loading from the unloaded state)."""
+
+    def begin_cycle(self) -> None:  # noqa: B027 - a hook, empty by default
+        """Called at the start of every cycle, after :meth:`set_surfaces` (default: nothing)."""
 
     @abstractmethod
     def solve_increment(self, offset: float) -> IncrementResult:
         """Move the upper body to ``offset`` (m) from the previous position and solve."""
 
-    @abstractmethod
     def subsurface_stress(
         self, result: IncrementResult, body: Body, depth: float, nz: int
     ) -> SubsurfaceStress:
         """Stress under ``body`` (0 <= z <= depth, m, ``nz`` levels) for a solved increment."""
+        raise Unsupported(f"{type(self).__name__} gives no subsurface stress")
+
+    # -- plastic strain (capability ``plastic``)
+    def plastic_steps(self) -> list[Any]:
+        """The plastic strain increments solved since the last call (then forgotten)."""
+        raise Unsupported(f"{type(self).__name__} gives no plastic strain")
+
+    @property
+    def plastic_depth(self) -> float:
+        """Depth of the grid on which plastic strain is solved, m."""
+        raise Unsupported(f"{type(self).__name__} gives no plastic strain")
+
+    # -- debris third body (capability ``debris``)
+    @property
+    def debris_pressure(self) -> NDArray[np.float64]:
+        """The prescribed debris pressure on the window, Pa [n, n] (zeros when none)."""
+        return np.zeros((self.n, self.n))
+
+    @property
+    def debris_load(self) -> float:
+        """Load carried by the debris, N."""
+        return 0.0
+
+    def set_debris_pressure(self, pressure: NDArray[np.float64] | None) -> None:
+        """Prescribe the debris pressure, Pa [n, n] (None clears)."""
+        raise Unsupported(f"{type(self).__name__} takes no debris pressure")
+
+    def loaded_solution(self, offset: float = 0.0, debris: bool = False
+                        ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """(pressure Pa, gap m) of the normal contact at ``offset`` under the full load,
+        without or with the debris pressure, leaving the load history untouched."""
+        raise Unsupported(f"{type(self).__name__} gives no separate loaded solution")
+
+    # -- resume
+    def state_dict(self) -> dict[str, Any]:
+        """Everything needed to continue bitwise after :meth:`load_state_dict`."""
+        raise Unsupported(f"{type(self).__name__} cannot save its state")
+
+    def load_state_dict(self, state: dict[str, Any]) -> None:
+        """Restore a state saved by :meth:`state_dict`."""
+        raise Unsupported(f"{type(self).__name__} cannot restore a state")
+
+
+def require(solver: FirstBodySolver, needs: frozenset[str] | set[str], who: str) -> None:
+    """Refuse (``ValueError`` naming ``who``, the backend and what is missing) a solver that
+    lacks a capability in ``needs``."""
+    missing = set(needs) - solver.capabilities.names()
+    if missing:
+        raise ValueError(
+            f"{who} needs {', '.join(CAPABILITY_TEXT.get(m, m) for m in sorted(missing))}, "
+            "which the first-body solver "
+            f"'{type(solver).__name__}' does not give (it gives: "
+            f"{', '.join(sorted(solver.capabilities.names()))})")
 
 
 def cycle_offsets(amplitude: float, n_increments: int) -> NDArray[np.float64]:
@@ -167,100 +292,3 @@ def cycle_offsets(amplitude: float, n_increments: int) -> NDArray[np.float64]:
     q = int(n_increments) // 4
     up = np.arange(1, q + 1) / q
     return amplitude * np.concatenate([up, 1 - up, -up, -1 + up])
-
-
-@dataclass
-class CycleResult:
-    """Accumulated results of one or more fretting cycles."""
-
-    x_upper: NDArray[np.float64]  #: upper-body grid x (own frame), m, [n]
-    x_lower: NDArray[np.float64]  #: lower-body track grid x (lab frame), m, [n_track]
-    y: NDArray[np.float64]  #: y coordinates shared by both grids, m, [n]
-    energy_upper: NDArray[np.float64]  #: dissipated energy density, J/m^2, [n, n]
-    energy_lower: NDArray[np.float64]  #: dissipated energy density, J/m^2, [n_track, n]
-    increments: list[IncrementResult] = field(default_factory=list)
-    cycles: int = 0
-
-    @property
-    def cell_area(self) -> float:
-        """Area of one grid cell, m^2."""
-        return float((self.x_upper[1] - self.x_upper[0]) * (self.y[1] - self.y[0]))
-
-    def dissipated_energy(self, body: Body) -> float:
-        """Total energy dissipated on ``body`` (integral of its density map), J."""
-        if body not in BODIES:
-            raise ValueError(f"body = {body!r} is not allowed: use 'upper' or 'lower'")
-        e = self.energy_upper if body == "upper" else self.energy_lower
-        return float(e.sum() * self.cell_area)
-
-
-class FrettingCycle:
-    """Drive a solver through fretting cycles and accumulate energy maps on both bodies.
-
-    The upper body's map is the window itself (fixed material points); the lower body's
-    map is a track of ``n + 2 K`` x-points (``K = ceil(A / dx) + 1``) covering every window
-    position; each increment's density is deposited on it at the window's lab position
-    with linear interpolation between the two neighbouring grid shifts (conservative).
-    """
-
-    def __init__(
-        self,
-        solver: FirstBodySolver,
-        amplitude: float = 0.3e-3,
-        n_increments: int = 48,
-        keep_increments: bool = False,
-    ) -> None:
-        self.solver = solver
-        self.amplitude = _check_positive("amplitude", amplitude)
-        self.offsets = cycle_offsets(amplitude, n_increments)
-        self.keep_increments = keep_increments
-        self.pad = int(math.ceil(self.amplitude / solver.dx)) + 1
-        n = solver.n
-        self.x_upper = solver.coords
-        self.x_lower = (np.arange(n + 2 * self.pad) - n // 2 - self.pad) * solver.dx
-        self.y = solver.coords.copy()
-        self._loaded = False
-        self.result = CycleResult(
-            x_upper=self.x_upper,
-            x_lower=self.x_lower,
-            y=self.y,
-            energy_upper=np.zeros((n, n)),
-            energy_lower=np.zeros((n + 2 * self.pad, n)),
-        )
-
-    def _deposit(self, inc: IncrementResult) -> None:
-        e = inc.energy_density
-        n = self.solver.n
-        self.result.energy_upper += e
-        # deposited at the increment's mid position (midpoint rule along the track)
-        shift = 0.5 * (inc.offset + inc.start_offset) / self.solver.dx
-        k = int(math.floor(shift))
-        w = shift - k
-        j0 = self.pad + k
-        self.result.energy_lower[j0 : j0 + n] += (1.0 - w) * e
-        if w > 0.0:
-            self.result.energy_lower[j0 + 1 : j0 + 1 + n] += w * e
-
-    def load(self) -> IncrementResult:
-        """Apply the normal load at offset 0 (no sliding, no dissipation)."""
-        self.solver.reset()
-        inc = self.solver.solve_increment(0.0)
-        self._loaded = True
-        if self.keep_increments:
-            self.result.increments.append(inc)
-        return inc
-
-    def run(self, n_cycles: int = 1) -> CycleResult:
-        """Run ``n_cycles`` cycles (loading first if needed); returns the accumulated maps."""
-        if int(n_cycles) != n_cycles or n_cycles < 1:
-            raise ValueError(f"n_cycles = {n_cycles!r} is not allowed: must be an integer >= 1")
-        if not self._loaded:
-            self.load()
-        for _ in range(int(n_cycles)):
-            for s in self.offsets:
-                inc = self.solver.solve_increment(float(s))
-                self._deposit(inc)
-                if self.keep_increments:
-                    self.result.increments.append(inc)
-            self.result.cycles += 1
-        return self.result

@@ -44,7 +44,13 @@ import tamaas.nonlinear_solvers  # noqa: F401  (registers tm.nonlinear_solvers)
 from numpy.typing import NDArray
 from scipy.interpolate import RegularGridInterpolator
 
-from tribodem.contact.base import Body, IncrementResult, SubsurfaceStress, _check_positive
+from tribodem.contact.base import (
+    Body,
+    Capabilities,
+    IncrementResult,
+    SubsurfaceStress,
+    _check_positive,
+)
 from tribodem.contact.geometry import Recession
 from tribodem.contact.halfspace import (
     HalfSpaceSolver,
@@ -115,6 +121,9 @@ class ElastoPlasticSolver(HalfSpaceSolver):
     (False). Both bodies must be of the same material.
     """
 
+    capabilities = Capabilities(plastic=True, partial_slip=True, subsurface=True, debris=True,
+                                contacts=("point",))
+
     def __init__(
         self,
         upper: Recession | None = None,
@@ -132,10 +141,10 @@ class ElastoPlasticSolver(HalfSpaceSolver):
         ep_tolerance: float = 1e-6,
         ep_max_iter: int = 300,
         reload_cycles: bool = False,
-        **kw: object,
+        **kw: Any,
     ) -> None:
         self._ep_ready = False
-        super().__init__(upper, lower, **kw)  # type: ignore[arg-type]
+        super().__init__(upper, lower, **kw)
         if self.upper_material != self.lower_material:
             raise ValueError(
                 "upper_material and lower_material differ: the elastic-plastic solver needs "
@@ -335,10 +344,15 @@ class ElastoPlasticSolver(HalfSpaceSolver):
             self.begin_cycle()
         return super().solve_increment(offset)
 
-    def pop_plastic_steps(self) -> list[PlasticStep]:
+    def plastic_steps(self) -> list[PlasticStep]:
         """EPIC load steps since the last call (for DFDI, eq 6.1); clears the list."""
         steps, self._steps = self._steps, []
         return steps
+
+    @property
+    def plastic_depth(self) -> float:
+        """Depth of the EP grid, m (``ep_depth_radii`` Hertz radii)."""
+        return self.ep_depth
 
     def plastic_fields(
         self, body: Body, offset: float, z: NDArray[np.float64]

@@ -20,7 +20,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.interpolate import RegularGridInterpolator
 
-Recession = Callable[[NDArray[np.float64], NDArray[np.float64]], NDArray[np.float64]]
+from tribodem.contact.base import Recession  # noqa: E402 - one definition, in the contract
 
 
 @dataclass(frozen=True)

@@ -39,10 +39,12 @@ from scipy.signal import fftconvolve
 from tribodem.contact.base import (
     BODIES,
     Body,
+    Capabilities,
     ElasticBody,
     FirstBodySolver,
     IncrementResult,
     SubsurfaceStress,
+    WindowTooSmallError,
     _check_positive,
     contact_modulus,
     dundurs_beta,
@@ -55,10 +57,6 @@ REGIMES = ("gross", "ciavarella-jaeger")
 
 #: offsets whose normal solution is kept as the initial guess for the next visit
 _WARM_STARTS = 64
-
-
-class WindowTooSmallError(RuntimeError):
-    """The contact reached the edge of the periodic window: enlarge ``window``."""
 
 
 def model_fields(model: tm.Model) -> dict[str, NDArray[np.float64]]:
@@ -114,6 +112,9 @@ class HalfSpaceSolver(FirstBodySolver):
     finite differences: give ``window`` explicitly for coarse height maps). ``regime`` is
     ``"gross"`` (q = mu p) or ``"ciavarella-jaeger"`` (partial slip after reversals).
     """
+
+    capabilities = Capabilities(partial_slip=True, subsurface=True, debris=True,
+                                contacts=("point",))
 
     def __init__(
         self,
@@ -222,9 +223,19 @@ class HalfSpaceSolver(FirstBodySolver):
                       for k, w in zip(state["warm_keys"], state["warm"], strict=True)}
         set_model_fields(self._model, state["model"])
         set_model_fields(self._model_star, state["model_star"])
-        self.debris_pressure = np.array(state["debris_pressure"], dtype=float)
-        self.debris_load = float(state["debris_load"])
+        self._debris_pressure = np.array(state["debris_pressure"], dtype=float)
+        self._debris_load = float(state["debris_load"])
         self._debris_u = np.array(state["debris_u"], dtype=float)
+
+    @property
+    def debris_pressure(self) -> NDArray[np.float64]:
+        """The prescribed debris pressure, Pa [n, n] (zeros when none)."""
+        return self._debris_pressure
+
+    @property
+    def debris_load(self) -> float:
+        """Load carried by the debris, N."""
+        return self._debris_load
 
     def set_debris_pressure(self, pressure: NDArray[np.float64] | None) -> None:
         """Prescribe the debris (third-body) pressure on the window, Pa [n, n] (None clears).
@@ -236,8 +247,8 @@ class HalfSpaceSolver(FirstBodySolver):
         """
         n = self.n
         if pressure is None:
-            self.debris_pressure = np.zeros((n, n))
-            self.debris_load = 0.0
+            self._debris_pressure = np.zeros((n, n))
+            self._debris_load = 0.0
             self._debris_u = np.zeros((n, n))
             return
         pd = np.asarray(pressure, dtype=float)
@@ -248,7 +259,7 @@ class HalfSpaceSolver(FirstBodySolver):
         if load >= self.load:
             raise ValueError(f"debris load {load:.4g} N >= applied load {self.load:.4g} N: "
                              "the solid-solid contact would carry nothing")
-        self.debris_pressure, self.debris_load = pd.copy(), load
+        self._debris_pressure, self._debris_load = pd.copy(), load
         u = fftconvolve(pd, self._kernel, mode="full")[n - 1 : 2 * n - 1, n - 1 : 2 * n - 1]
         self._debris_u = u / (math.pi * self.modulus)
 

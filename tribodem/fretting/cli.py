@@ -16,9 +16,10 @@ from pydantic import BaseModel, ConfigDict, Field, field_validator
 
 from tribodem import __version__
 from tribodem.contact import (
+    BACKENDS,
+    CAPABILITY_TEXT,
     ElasticBody,
-    ElastoPlasticSolver,
-    HalfSpaceSolver,
+    FirstBodySolver,
     HertzSphere,
     contact_modulus,
     crossed_cylinders,
@@ -26,6 +27,7 @@ from tribodem.contact import (
 from tribodem.cyclejump import STRATEGIES, make_strategy
 from tribodem.fretting.criteria import (
     ALPHA_SEED,
+    ARCHARD_K,
     CRITERIA,
     UTS_EN24T,
     YIELD_EN24T,
@@ -48,6 +50,7 @@ from tribodem.fretting.output import (
 from tribodem.io import runs
 from tribodem.io.config import ConfigError, dump_toml, load_toml, merge, validate
 from tribodem.io.results import write_text
+from tribodem.materials.en24t import EN24T
 
 CriterionName = Literal["energy", "archard", "s22", "von_mises", "shear", "dfdi", "swt"]
 JumpName = Literal["none", "constant", "cojocaru", "moving", "overlapping", "adaptive"]
@@ -69,8 +72,8 @@ class ContactConfig(_Model):
     n: int = Field(256, ge=16, le=2048, description="window points per side (even)")
     window: float | None = Field(None, gt=0, description="window side, m (None: 10 radii)")
     tolerance: float = Field(1e-6, gt=0, lt=1, description="normal solver (PKR) tolerance")
-    young: float = Field(240e9, gt=0, description="Young's modulus (both bodies), Pa")
-    poisson: float = Field(0.3, gt=-1, lt=0.5, description="Poisson's ratio")
+    young: float = Field(EN24T.young, gt=0, description="Young's modulus (both bodies), Pa")
+    poisson: float = Field(EN24T.poisson, gt=-1, lt=0.5, description="Poisson's ratio")
 
     @field_validator("n_increments")
     @classmethod
@@ -92,7 +95,10 @@ class WearConfig(_Model):
 
     criterion: CriterionName = "energy"
     alpha: float = Field(ALPHA_SEED, ge=0, description="energy wear coefficient, m^3/J")
-    archard_k: float = Field(ALPHA_SEED * 0.6, ge=0, description="local Archard k, 1/Pa")
+    energy_share_upper: float = Field(
+        0.5, ge=0, le=1, description="energy: upper body's share of eq 2.7's total volume")
+    archard_k_upper: float = Field(ARCHARD_K, ge=0, description="Archard k, upper body, 1/Pa")
+    archard_k_lower: float = Field(ARCHARD_K, ge=0, description="Archard k, lower body, 1/Pa")
     yield_strength: float = Field(YIELD_EN24T, gt=0, description="Pa (s22, von_mises)")
     uts: float = Field(UTS_EN24T, gt=0, description="Pa (shear: S_us = 0.8 UTS)")
     stress_depth: float | None = Field(None, gt=0, description="subsurface grid depth, m")
@@ -106,9 +112,10 @@ class WearConfig(_Model):
 class PlasticConfig(_Model):
     """``solver = "elastic-plastic"``: tamaas EPIC, bilinear EN24T (seed table 5.1)."""
 
-    yield_strength: float = Field(680e6, gt=0, description="initial yield, Pa")
-    uts: float = Field(1000e6, gt=0, description="ultimate tensile strength, Pa")
-    uts_strain: float = Field(0.132, gt=0, lt=1, description="engineering strain at UTS")
+    yield_strength: float = Field(EN24T.yield_strength, gt=0, description="initial yield, Pa")
+    uts: float = Field(EN24T.uts, gt=0, description="ultimate tensile strength, Pa")
+    uts_strain: float = Field(EN24T.uts_strain, gt=0, lt=1,
+                              description="engineering strain at UTS")
     hardening: float | None = Field(None, ge=0, description="h, Pa (None: bilinear)")
     ep_n: int = Field(32, ge=8, le=256, description="EP grid points per side (even)")
     ep_nz: int = Field(12, ge=3, le=64, description="EP grid layers")
@@ -156,13 +163,20 @@ class FrettingConfig(_Model):
     """``tribodem fretting run`` configuration (TOML tables contact, wear, jump, output)."""
 
     cycles: int = Field(160, ge=1, le=10**7)
-    solver: Literal["elastic", "elastic-plastic"] = "elastic"
+    solver: str = Field("elastic", description="first-body backend (tribodem.contact.BACKENDS)")
     contact: ContactConfig = Field(default_factory=ContactConfig)
     wear: WearConfig = Field(default_factory=WearConfig)
     jump: JumpConfig = Field(default_factory=JumpConfig)
     plastic: PlasticConfig = Field(default_factory=PlasticConfig)
     debris: DebrisConfig = Field(default_factory=DebrisConfig)
     output: OutputConfig = Field(default_factory=OutputConfig)
+
+    @field_validator("solver")
+    @classmethod
+    def _known_backend(cls, v: str) -> str:
+        if v not in BACKENDS:
+            raise ValueError(f"not a first-body backend; allowed: {', '.join(BACKENDS)}")
+        return v
 
 
 QUICK: dict[str, Any] = {"cycles": 10, "contact": {"n": 64}, "wear": {"stress_nz": 17},
@@ -175,8 +189,8 @@ def build_criterion(cfg: FrettingConfig) -> Criterion:
     name = w.criterion
     stress = {"depth": w.stress_depth, "nz": w.stress_nz, "samples": w.stress_samples}
     params: dict[str, Any] = {
-        "energy": {"alpha": w.alpha},
-        "archard": {"k": w.archard_k},
+        "energy": {"alpha": w.alpha, "share_upper": w.energy_share_upper},
+        "archard": {"k_upper": w.archard_k_upper, "k_lower": w.archard_k_lower},
         "s22": {"yield_strength": w.yield_strength, **stress},
         "von_mises": {"yield_strength": w.yield_strength, **stress},
         "shear": {"uts": w.uts, **stress},
@@ -243,33 +257,49 @@ def check_jump_params(strategy: str, params: dict[str, Any]) -> None:
                 f"allowed: {', '.join(allowed)}")
 
 
+def check_compatible(cfg: FrettingConfig) -> None:
+    """Refuse, before any work, a criterion (or the debris third body) that needs what the
+    chosen first-body backend cannot give, naming both and the backends that would do."""
+    backend = BACKENDS[cfg.solver]
+    have = backend.capabilities.names()
+    needs = [(f"wear.criterion = {cfg.wear.criterion!r}", CRITERIA[cfg.wear.criterion].requires)]
+    if cfg.debris.every is not None:
+        needs.append(("debris.every (the debris third body)", frozenset({"debris"})))
+    for who, req in needs:
+        missing = set(req) - have
+        if missing:
+            ok = [k for k, b in BACKENDS.items() if set(req) <= b.capabilities.names()]
+            raise ConfigError(
+                f"{who} needs {', '.join(CAPABILITY_TEXT.get(m, m) for m in sorted(missing))}, "
+                f"which solver = {cfg.solver!r} "
+                f"({backend.__name__}) does not give; allowed: solver = "
+                f"{' or '.join(repr(k) for k in ok) or '(none registered)'}")
+
+
+def build_solver(cfg: FrettingConfig) -> FirstBodySolver:
+    """The configured first-body backend (:data:`tribodem.contact.BACKENDS`) on the case."""
+    c = cfg.contact
+    mat = ElasticBody(young=c.young, poisson=c.poisson)
+    backend = BACKENDS[cfg.solver]
+    upper, lower = crossed_cylinders(c.diameter)
+    kw: dict[str, Any] = dict(
+        load=c.load, friction=c.friction, upper_material=mat, lower_material=mat,
+        n=c.n, window=c.window, regime=c.regime, tolerance=c.tolerance)
+    if backend.capabilities.plastic:
+        kw |= cfg.plastic.model_dump()
+    try:
+        return backend(upper, lower, **kw)
+    except ValueError as err:
+        raise ConfigError(f"contact: {err}") from None
+
+
 def build_loop(cfg: FrettingConfig) -> FrettingLoop:
     """Solver + criterion + strategy from a validated config (``ConfigError`` if unusable)."""
-    if cfg.wear.criterion == "dfdi" and cfg.solver != "elastic-plastic":
-        raise ConfigError(
-            f"wear.criterion = 'dfdi' with solver = {cfg.solver!r}: DFDI (eqs 6.1-6.2) needs "
-            "the equivalent plastic strain; allowed: solver = 'elastic-plastic'"
-        )
+    check_compatible(cfg)
     check_window(cfg)
     crit = build_criterion(cfg)
     c = cfg.contact
-    mat = ElasticBody(young=c.young, poisson=c.poisson)
-    try:
-        upper, lower = crossed_cylinders(c.diameter)
-        common: dict[str, Any] = dict(
-            load=c.load, friction=c.friction, upper_material=mat, lower_material=mat,
-            n=c.n, window=c.window, regime=c.regime, tolerance=c.tolerance)
-        if cfg.solver == "elastic-plastic":
-            pc = cfg.plastic
-            solver: HalfSpaceSolver = ElastoPlasticSolver(
-                upper, lower, yield_strength=pc.yield_strength, hardening=pc.hardening,
-                uts=pc.uts, uts_strain=pc.uts_strain, ep_n=pc.ep_n, ep_nz=pc.ep_nz,
-                ep_window_radii=pc.ep_window_radii, ep_depth_radii=pc.ep_depth_radii,
-                load_steps=pc.load_steps, ep_tolerance=pc.ep_tolerance, **common)
-        else:
-            solver = HalfSpaceSolver(upper, lower, **common)
-    except ValueError as err:
-        raise ConfigError(f"contact: {err}") from None
+    solver = build_solver(cfg)
     strategy = None
     if cfg.jump.strategy != "none":
         check_jump_params(cfg.jump.strategy, cfg.jump.params)
@@ -291,7 +321,7 @@ def build_loop(cfg: FrettingConfig) -> FrettingLoop:
         return FrettingLoop(solver, crit, amplitude=c.amplitude, n_increments=c.n_increments,
                             strategy=strategy, debris=debris,
                             debris_every=cfg.debris.every or 1)
-    except ValueError as err:
+    except ValueError as err:  # CriterionUnavailable included
         raise ConfigError(f"wear: {err}") from None
 
 
@@ -459,7 +489,7 @@ def run_cmd(
     jump: Annotated[str | None, typer.Option(
         "--jump", help=f"none or one of: {', '.join(STRATEGIES)}.")] = None,
     solver: Annotated[str | None, typer.Option(
-        "--solver", help="elastic or elastic-plastic.")] = None,
+        "--solver", help=f"First-body backend: {', '.join(BACKENDS)}.")] = None,
     debris_every: Annotated[int | None, typer.Option(
         "--debris-every", help="Debris third body: a DE phase every K cycles.")] = None,
     no_debris: Annotated[bool, typer.Option(
@@ -475,7 +505,7 @@ def run_cmd(
     """Run the fretting wear loop; writes results.csv, summary.json, figures, VTK to --out."""
     for opt, value, allowed in (("--criterion", criterion, tuple(CRITERIA)),
                                 ("--jump", jump, ("none", *STRATEGIES)),
-                                ("--solver", solver, ("elastic", "elastic-plastic"))):
+                                ("--solver", solver, tuple(BACKENDS))):
         if value is not None and value not in allowed:
             raise ConfigError(f"{opt} = {value!r}: allowed: {', '.join(allowed)}")
     ov: dict[str, Any] = {}

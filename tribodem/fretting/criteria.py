@@ -33,7 +33,7 @@ from typing import Any, ClassVar
 import numpy as np
 from numpy.typing import NDArray
 
-from tribodem.contact.base import FirstBodySolver, IncrementResult, SubsurfaceStress
+from tribodem.contact.base import FirstBodySolver, IncrementResult, SubsurfaceStress, require
 
 #: Fouvry energy wear coefficient of the seed (section 5.2), 1.641e-6 mm^3/J, in m^3/J.
 ALPHA_SEED = 1.641e-6 * 1e-9
@@ -157,6 +157,8 @@ class Criterion(ABC):
 
     name: ClassVar[str] = "base"
     kind: ClassVar[str] = "rate"  #: "rate" or "threshold"
+    #: first-body capabilities it needs (:class:`tribodem.contact.Capabilities` names)
+    requires: ClassVar[frozenset[str]] = frozenset()
     #: attributes not carried from one cycle to the next (remade by :meth:`begin_cycle`),
     #: left out of :meth:`state`
     _SCRATCH: ClassVar[frozenset[str]] = frozenset(
@@ -170,6 +172,16 @@ class Criterion(ABC):
     def set_state(self, state: dict[str, Any]) -> None:
         """Restore :meth:`state` (the next :meth:`begin_cycle` remakes the scratch)."""
         vars(self).update(state)
+
+    def set_increments(self, n_increments: int) -> None:  # noqa: B027 - optional hook
+        """Told how many sliding increments a cycle has (default: not needed)."""
+
+    def check_solver(self, solver: FirstBodySolver) -> None:
+        """Refuse (``CriterionUnavailable``, naming both) a solver lacking what it needs."""
+        try:
+            require(solver, self.requires, f"criterion '{self.name}'")
+        except ValueError as err:
+            raise CriterionUnavailable(str(err)) from None
 
     def begin_cycle(self, grid: TrackGrid, solver: FirstBodySolver) -> None:
         """Reset the per-cycle accumulators."""
@@ -195,12 +207,13 @@ class Criterion(ABC):
 
 class RateCriterion(Criterion):
     """A local rate law: each increment adds ``coefficient x local_rate(inc)`` (m) to the
-    wear depth of every point; the lower body gets the same field on its track."""
+    wear depth of every point, with one coefficient per body (:attr:`coefficients`); the
+    lower body gets the field on its track."""
 
     @property
     @abstractmethod
-    def coefficient(self) -> float:
-        """Wear coefficient multiplying the accumulated field."""
+    def coefficients(self) -> tuple[float, float]:
+        """Wear coefficients (upper, lower) multiplying the accumulated field."""
 
     @abstractmethod
     def local_rate(self, inc: IncrementResult) -> NDArray[np.float64]:
@@ -217,58 +230,78 @@ class RateCriterion(Criterion):
         self.grid.deposit(self._lo, f, inc)
 
     def depths(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        c = self.coefficient
-        return c * self._up, c * self._lo
+        cu, cl = self.coefficients
+        return cu * self._up, cl * self._lo
+
+
+def _coefficient(name: str, v: float) -> float:
+    if not (math.isfinite(v) and v >= 0):
+        raise ValueError(f"{name} = {v!r} is not allowed: must be finite and >= 0")
+    return float(v)
 
 
 class EnergyCriterion(RateCriterion):
-    """Fouvry's energy law per surface point: dh = alpha e (m), e in J/m^2 (seed eq 2.7).
+    """Fouvry's energy law (seed eqs 2.7-2.8): W_v = alpha x sum E_d, per surface point.
 
-    Each body loses ``alpha`` times the interface energy dissipated on it (the density is
-    the same on both bodies), so each body's worn volume is alpha times the dissipated
-    energy. ``alpha`` in m^3/J (default 1.641e-6 mm^3/J, seed section 5.2).
+    Eq 2.7 relates the *total* worn volume (both bodies) to the energy dissipated by the
+    interface. The loop shares it: the upper body loses ``share_upper x alpha x e`` (m) and
+    the lower ``(1 - share_upper) x alpha x e`` at each point (e in J/m^2, the same density
+    on both bodies), so their volumes add up to alpha x the dissipated energy. Default share
+    0.5 (two bodies of one material, as in the seed's EN24T/EN24T tests). ``alpha`` in
+    m^3/J (default 1.641e-6 mm^3/J, seed section 5.2).
     """
 
     name = "energy"
 
-    def __init__(self, alpha: float = ALPHA_SEED) -> None:
-        if not (math.isfinite(alpha) and alpha >= 0):
-            raise ValueError(f"alpha = {alpha!r} is not allowed: must be finite and >= 0 m^3/J")
-        self.alpha = float(alpha)
+    def __init__(self, alpha: float = ALPHA_SEED, share_upper: float = 0.5) -> None:
+        self.alpha = _coefficient("alpha", alpha)
+        if not 0.0 <= share_upper <= 1.0:
+            raise ValueError(f"share_upper = {share_upper!r} is not allowed: must be in [0, 1]")
+        self.share_upper = float(share_upper)
 
     @property
-    def coefficient(self) -> float:
-        return self.alpha
+    def coefficients(self) -> tuple[float, float]:
+        return self.alpha * self.share_upper, self.alpha * (1.0 - self.share_upper)
 
     def local_rate(self, inc: IncrementResult) -> NDArray[np.float64]:
         return inc.energy_density
 
     def params(self) -> dict[str, Any]:
-        return {"alpha_m3_per_J": self.alpha}
+        return {"alpha_m3_per_J": self.alpha, "share_upper": self.share_upper,
+                "convention": "eq 2.7 total volume (upper + lower) = alpha x dissipated "
+                              "energy, shared share_upper : 1 - share_upper"}
+
+
+#: Archard k per body (1/Pa) by default: alpha mu / 2 with the seed's alpha and mu = 0.6,
+#: the same wear as ``energy`` (equal share) in gross slip.
+ARCHARD_K = ALPHA_SEED * 0.6 / 2
 
 
 class ArchardCriterion(RateCriterion):
-    """Local Archard law (seed eq 2.6): dh = k p |ds| per increment, k in 1/Pa (m^2/N).
+    """Local Archard law (seed eq 2.6) on each body: dh = k_body p |ds| per increment.
 
-    Default k = alpha mu (1.641e-6 mm^3/J x 0.6): the same wear as ``energy`` in gross slip.
+    ``k_upper``/``k_lower`` in 1/Pa (m^2/N): each body's worn volume is k_body x P x sliding
+    distance in gross slip. ``k`` sets both. Default :data:`ARCHARD_K` each.
     """
 
     name = "archard"
 
-    def __init__(self, k: float = ALPHA_SEED * 0.6) -> None:
-        if not (math.isfinite(k) and k >= 0):
-            raise ValueError(f"k = {k!r} is not allowed: must be finite and >= 0 (1/Pa)")
-        self.k = float(k)
+    def __init__(self, k: float | None = None, k_upper: float | None = None,
+                 k_lower: float | None = None) -> None:
+        both = ARCHARD_K if k is None else _coefficient("k", k)
+        self.k_upper = both if k_upper is None else _coefficient("k_upper", k_upper)
+        self.k_lower = both if k_lower is None else _coefficient("k_lower", k_lower)
 
     @property
-    def coefficient(self) -> float:
-        return self.k
+    def coefficients(self) -> tuple[float, float]:
+        return self.k_upper, self.k_lower
 
     def local_rate(self, inc: IncrementResult) -> NDArray[np.float64]:
         return inc.pressure * np.hypot(inc.slip[..., 0], inc.slip[..., 1])
 
     def params(self) -> dict[str, Any]:
-        return {"k_per_Pa": self.k}
+        return {"k_upper_per_Pa": self.k_upper, "k_lower_per_Pa": self.k_lower,
+                "convention": "each body: volume = k_body x P x sliding distance"}
 
 
 class ThresholdCriterion(Criterion):
@@ -285,6 +318,7 @@ class ThresholdCriterion(Criterion):
 
     kind = "threshold"
     unit: ClassVar[str] = "Pa"
+    requires = frozenset({"subsurface"})
 
     def __init__(self, threshold: float, depth: float | None = None, nz: int = 33,
                  samples: int = 8) -> None:
@@ -449,11 +483,12 @@ class DFDICriterion(Criterion):
     up as wear removes material); wear depth by :func:`column_search` at DFDI = 1.
     ``eps0`` default 0.132 (engineering strain at the UTS implied by seed table 6.2's
     1000 -> 1132 MPa conversion; the seed gives no number). Needs a solver that exposes
-    ``pop_plastic_steps()`` (:class:`tribodem.contact.ElastoPlasticSolver`).
+    a solver with the ``plastic`` capability (:class:`tribodem.contact.ElastoPlasticSolver`).
     """
 
     name = "dfdi"
     kind = "threshold"
+    requires = frozenset({"plastic"})
 
     def __init__(self, eps0: float = 0.132, depth: float | None = None, nz: int = 33) -> None:
         if not (math.isfinite(eps0) and eps0 > 0):
@@ -465,16 +500,6 @@ class DFDICriterion(Criterion):
         self._d_up: NDArray[np.float64] | None = None
         self._d_lo: NDArray[np.float64] | None = None
         self._last_info: dict[str, Any] = {}
-
-    @staticmethod
-    def check_solver(solver: object) -> None:
-        """Refuse a solver without plastic strain (eqs 6.1-6.2 need it)."""
-        if not callable(getattr(solver, "pop_plastic_steps", None)):
-            raise CriterionUnavailable(
-                "criterion 'dfdi' needs the equivalent plastic strain (eqs 6.1-6.2): use the "
-                "elastic-plastic solver (solver = 'elastic-plastic'); "
-                f"{type(solver).__name__} is elastic"
-            )
 
     def failure_strain(self, stress: NDArray[np.float64]) -> NDArray[np.float64]:
         """eps_f of eq 6.2 for Voigt stresses [..., 6] (xx, yy, zz, yz, xz, xy), -."""
@@ -495,7 +520,7 @@ class DFDICriterion(Criterion):
         self.check_solver(solver)
         super().begin_cycle(grid, solver)
         if self.depth is None:
-            self.depth = float(solver.ep_depth)  # type: ignore[attr-defined]
+            self.depth = float(solver.plastic_depth)
         self._z = np.linspace(0.0, self.depth, self.nz)
         if self._d_up is None:
             self._d_up = np.zeros((self.nz, grid.n, grid.n))
@@ -509,7 +534,7 @@ class DFDICriterion(Criterion):
 
         assert self._d_up is not None and self._d_lo is not None
         g = self.grid
-        steps = self.solver.pop_plastic_steps()  # type: ignore[attr-defined]
+        steps = self.solver.plastic_steps()
         if steps:
             dd = sum(self.damage_increment(st.dp, st.stress) for st in steps)
             c = steps[0].x

@@ -25,11 +25,10 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from tribodem.contact.base import FirstBodySolver, cycle_offsets
+from tribodem.contact.base import FirstBodySolver, WindowTooSmallError, cycle_offsets, require
 from tribodem.contact.geometry import HeightMap, Recession
-from tribodem.contact.halfspace import WindowTooSmallError
 from tribodem.cyclejump import JumpStrategy
-from tribodem.fretting.criteria import Criterion, ThresholdCriterion, TrackGrid
+from tribodem.fretting.criteria import Criterion, CriterionUnavailable, TrackGrid
 from tribodem.fretting.debris import DebrisField, DEPhaseResult, debris_target, run_de_phase
 
 #: Columns of ``results.csv`` (one row per simulated or jumped cycle).
@@ -139,10 +138,13 @@ def _scar_mean(w: NDArray[np.float64]) -> float:
 class FrettingLoop:
     """Fretting wear loop on a first-body solver with worn-surface geometry update.
 
-    ``solver`` must expose its surfaces as attributes ``upper`` and ``lower`` (recessions,
-    m), as :class:`tribodem.contact.HalfSpaceSolver` does; the loop replaces them by
-    :class:`WornSurface` each cycle. ``amplitude`` m, ``n_increments`` per cycle (multiple
-    of 4). ``strategy``: a :class:`tribodem.cyclejump.JumpStrategy` or None (no jumping).
+    The only driver of fretting cycles. It uses the solver through the first-body contract
+    (:class:`tribodem.contact.FirstBodySolver`) alone: each cycle it gives the solver the
+    worn surfaces (:class:`WornSurface`, via ``set_surfaces``). ``amplitude`` m,
+    ``n_increments`` per cycle (multiple of 4). ``strategy``: a
+    :class:`tribodem.cyclejump.JumpStrategy` or None (no jumping). A criterion or the debris
+    third body that needs what the solver cannot give is refused here, before any work
+    (``CriterionUnavailable``).
     """
 
     def __init__(
@@ -155,23 +157,24 @@ class FrettingLoop:
         debris: DebrisField | None = None,
         debris_every: int = 1,
     ) -> None:
-        if not (hasattr(solver, "upper") and hasattr(solver, "lower")):
-            raise TypeError("solver must expose its surfaces as .upper and .lower recessions")
+        criterion.check_solver(solver)
+        if debris is not None:
+            try:
+                require(solver, {"debris"}, "the debris third body")
+            except ValueError as err:
+                raise CriterionUnavailable(str(err)) from None
         self.solver = solver
         self.criterion = criterion
         self.offsets = cycle_offsets(amplitude, n_increments)
         self.amplitude = float(amplitude)
         self.strategy = strategy
-        if isinstance(criterion, ThresholdCriterion):
-            criterion.set_increments(n_increments)
+        criterion.set_increments(n_increments)
         n, dx = solver.n, solver.dx
         self.grid = TrackGrid(n=n, dx=dx, pad=int(math.ceil(self.amplitude / dx)) + 1)
-        self.base_upper: Recession = solver.upper  # type: ignore[attr-defined]
-        self.base_lower: Recession = solver.lower  # type: ignore[attr-defined]
+        self.base_upper: Recession = solver.upper
+        self.base_lower: Recession = solver.lower
         self.wear_upper = np.zeros((n, n))
         self.wear_lower = np.zeros((self.grid.n_track, n))
-        if debris is not None and not hasattr(solver, "set_debris_pressure"):
-            raise TypeError("debris needs a solver with set_debris_pressure (HalfSpaceSolver)")
         if int(debris_every) != debris_every or debris_every < 1:
             raise ValueError(f"debris_every = {debris_every!r}: must be an integer >= 1 cycle")
         self.debris = debris
@@ -190,17 +193,17 @@ class FrettingLoop:
         d, sol = self.debris, self.solver
         assert d is not None
         c = sol.coords
-        target = debris_target(d, self._p_load, c, sol.dx, sol.load)  # type: ignore[attr-defined]
+        target = debris_target(d, self._p_load, c, sol.dx, sol.load)
         if target <= 0.0:
-            sol.set_debris_pressure(None)  # type: ignore[attr-defined]
+            sol.set_debris_pressure(None)
             return {"de_phase": 0}
         xw, yw = np.meshgrid(c, c, indexing="ij")
-        lower = np.asarray(sol.lower(xw, yw), dtype=float)  # type: ignore[attr-defined]
-        p_without, gap = sol.loaded_solution(0.0)  # type: ignore[attr-defined]
+        lower = np.asarray(sol.lower(xw, yw), dtype=float)
+        p_without, gap = sol.loaded_solution(0.0)
         res = run_de_phase(d, lower, gap, c, target, cycle=self._cycle)
-        sol.set_debris_pressure(res.pressure)  # type: ignore[attr-defined]
+        sol.set_debris_pressure(res.pressure)
         res.pressure_without = p_without
-        res.pressure_with = sol.loaded_solution(0.0, debris=True)[0]  # type: ignore[attr-defined]
+        res.pressure_with = sol.loaded_solution(0.0, debris=True)[0]
         self.de_phases.append(res)
         return {"de_phase": 1}
 
@@ -216,8 +219,8 @@ class FrettingLoop:
         y0 = float(g.y[0])
         up = HeightMap(self.wear_upper, g.dx, g.dx, float(g.x_upper[0]), y0)
         lo = HeightMap(self.wear_lower, g.dx, g.dx, float(g.x_lower[0]), y0)
-        self.solver.upper = WornSurface(self.base_upper, up)  # type: ignore[attr-defined]
-        self.solver.lower = WornSurface(self.base_lower, lo)  # type: ignore[attr-defined]
+        self.solver.set_surfaces(WornSurface(self.base_upper, up),
+                                 WornSurface(self.base_lower, lo))
 
     def _state(self) -> NDArray[np.float64]:
         return np.concatenate([self.wear_upper.ravel(), self.wear_lower.ravel()])
@@ -241,14 +244,13 @@ class FrettingLoop:
             extra["de_phase"] = 0
             if self._cycle % self.debris_every == 0 and self.debris.n > 0:
                 extra |= self._de_phase()
-        begin = getattr(self.solver, "begin_cycle", None)
-        if callable(begin):  # solver hook at cycle start (elastic-plastic solver)
-            begin()
+        self.solver.begin_cycle()  # the solver's hook (elastic-plastic: EPIC at full load)
         crit = self.criterion
         crit.begin_cycle(self.grid, self.solver)
         cell = self.grid.cell_area
         energy = pmax = qmax = area = pmax_d = balance = 0.0
-        pd = getattr(self.solver, "debris_pressure", None)
+        pd = self.solver.debris_pressure if self.debris is not None else None
+        load = self.solver.load
         for i, s in enumerate(self.offsets):
             inc = self.solver.solve_increment(float(s))
             crit.add_increment(i, inc)
@@ -259,7 +261,6 @@ class FrettingLoop:
             if self.debris is not None and pd is not None:
                 total = inc.pressure + pd
                 pmax_d = max(pmax_d, float(total.max()))
-                load = self.solver.load  # type: ignore[attr-defined]
                 balance = max(balance, abs(float(total.sum()) * cell - load) / load)
                 if s == 0.0:
                     self._p_load = total
@@ -270,9 +271,8 @@ class FrettingLoop:
         self.wear_lower = self.wear_lower + dl
         self._generate_debris(du, dl)
         if self.debris is not None:
-            load = self.solver.load  # type: ignore[attr-defined]
             extra |= {"debris_particles": self.debris.n,
-                      "debris_load_fraction": float(self.solver.debris_load) / load,  # type: ignore[attr-defined]
+                      "debris_load_fraction": float(self.solver.debris_load) / load,
                       "max_pressure_with_debris_Pa": pmax_d,
                       "load_balance_error": balance}
         return {
@@ -361,17 +361,13 @@ class FrettingLoop:
         hist = self.history
         if hist is None:
             raise RuntimeError("nothing to save before the first loading (run() first)")
-        save = getattr(self.solver, "state_dict", None)
-        if not callable(save):
-            raise TypeError(f"{type(self.solver).__name__} cannot save its state "
-                            "(no state_dict method)")
         return {
             "cycle": self._cycle, "done": self._done,
             "observe_pending": self._observe_pending, "last_per": dict(self._last_per),
             "wall_time_s": hist.wall_time_s,
             "wear_upper": self.wear_upper.copy(), "wear_lower": self.wear_lower.copy(),
             "p_load": np.asarray(self._p_load, dtype=float).copy(),
-            "solver": save(),
+            "solver": self.solver.state_dict(),
             "criterion": self.criterion.state(),
             "strategy": None if self.strategy is None else dict(vars(self.strategy)),
             "debris": None if self.debris is None else dict(vars(self.debris)),
@@ -402,7 +398,7 @@ class FrettingLoop:
         self._last_per = dict(state["last_per"])
         self._wall = float(state["wall_time_s"])
         self._apply_geometry()
-        self.solver.load_state_dict(state["solver"])  # type: ignore[attr-defined]
+        self.solver.load_state_dict(state["solver"])
         self.criterion.set_state(state["criterion"])
         if self.strategy is not None:
             vars(self.strategy).update(state["strategy"])
@@ -451,7 +447,7 @@ class FrettingLoop:
             except WindowTooSmallError as err:
                 self.history.stopped = f"first loading: {err}"
                 return self._finish(t0)
-            self._p_load = first.pressure + getattr(self.solver, "debris_pressure", 0.0)
+            self._p_load = first.pressure + self.solver.debris_pressure
             if self.strategy is not None:
                 self.strategy.observe(0, self._state())
         hist = self.history

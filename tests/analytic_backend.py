@@ -1,0 +1,70 @@
+"""A first-body backend in one file, written against the contract alone: the closed-form
+Hertz sphere-on-flat contact in gross slip (q = mu p against the sliding direction).
+
+It ignores wear (the surfaces it is given do not change its answer) and gives no subsurface
+stress: it declares so in its capabilities, and the loop must refuse a criterion that needs
+more. Registered by one line: ``BACKENDS["analytic-hertz"] = AnalyticHertzSolver``.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from tribodem.contact import (
+    Capabilities,
+    ElasticBody,
+    FirstBodySolver,
+    HertzSphere,
+    IncrementResult,
+    contact_modulus,
+    crossed_cylinders,
+)
+
+
+class AnalyticHertzSolver(FirstBodySolver):
+    """Hertz pressure of a sphere of radius ``radius`` (m) under ``load`` (N) on an n x n
+    window of ``window`` (m); gross slip with friction ``friction``."""
+
+    capabilities = Capabilities(subsurface=False, contacts=("point",))
+
+    def __init__(self, upper: Any = None, lower: Any = None, load: float = 100.0,
+                 friction: float = 0.6, upper_material: ElasticBody | None = None,
+                 lower_material: ElasticBody | None = None, n: int = 64,
+                 window: float | None = None, radius: float = 4e-3, **_: Any) -> None:
+        if upper is None or lower is None:
+            upper, lower = crossed_cylinders()
+        self.upper, self.lower = upper, lower
+        self.load, self.friction, self.n = float(load), float(friction), int(n)
+        e_star = contact_modulus(upper_material or ElasticBody(),
+                                 lower_material or ElasticBody())
+        self.hertz = HertzSphere(radius, self.load, e_star)
+        self.dx = (window or 10 * self.hertz.contact_radius) / self.n
+        self.reset()
+
+    def reset(self) -> None:
+        self._offset = 0.0
+
+    def solve_increment(self, offset: float) -> IncrementResult:
+        step = offset - self._offset
+        xw, yw = np.meshgrid(self.coords, self.coords, indexing="ij")
+        p = self.hertz.pressure(np.hypot(xw, yw))
+        inside = p > 0
+        traction = np.zeros((self.n, self.n, 2))
+        slip = np.zeros((self.n, self.n, 2))
+        if step != 0.0:
+            traction[..., 0] = -np.sign(step) * self.friction * p
+            slip[inside, 0] = step
+        inc = IncrementResult(offset=offset, start_offset=self._offset,
+                              direction=float(np.sign(step)), pressure=p, traction=traction,
+                              slip=slip, contact_area=float(inside.sum()) * self.dx**2,
+                              normal_load=float(p.sum()) * self.dx**2)
+        self._offset = offset
+        return inc
+
+    def state_dict(self) -> dict[str, Any]:
+        return {"offset": self._offset}
+
+    def load_state_dict(self, state: dict[str, Any]) -> None:
+        self._offset = float(state["offset"])
