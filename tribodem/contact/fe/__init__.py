@@ -4,7 +4,8 @@ Plane-strain cylindrical pad on a flat (line contact): graded quadrilateral mesh
 (:mod:`.mesh`), ccx deck with seating, normal load and a tangential displacement cycle
 (:mod:`.deck`), ccx runner with a wall-clock limit and clear errors (:mod:`.ccx`), ``.dat`` /
 ``.frd`` readers with contact tractions recovered from element nodal forces (:mod:`.results`),
-one-call runs (:mod:`.model`) and closed-form checks (:mod:`.validate`).
+one-call runs (:mod:`.model`) and closed-form checks (:mod:`.validate`, also
+``python -m tribodem.contact.fe.validate``).
 """
 
 from tribodem.contact.fe.ccx import (
@@ -27,7 +28,6 @@ from tribodem.contact.fe.results import (
     read_frd,
     read_results,
 )
-from tribodem.contact.fe.validate import validate_fe
 
 __all__ = [
     "INSTALL_COMMAND",
@@ -54,6 +54,5 @@ __all__ = [
     "read_results",
     "run_ccx",
     "run_line_case",
-    "validate_fe",
     "write_deck",
 ]

@@ -104,6 +104,15 @@ def _error_text(log: str) -> str:
     return " | ".join(out)
 
 
+def _kill(proc: subprocess.Popen[bytes]) -> None:
+    """Kill ccx's process group (it runs in its own session) and reap it."""
+    try:
+        os.killpg(proc.pid, signal.SIGKILL)
+    except ProcessLookupError:
+        pass
+    proc.wait()
+
+
 def run_ccx(deck: str | Path, threads: int = 1, timeout: float = 600.0,
             executable: str = "ccx") -> CcxRun:
     """Run ``ccx -i <job>`` in the deck's folder; see the module docstring for failures."""
@@ -123,10 +132,12 @@ def run_ccx(deck: str | Path, threads: int = 1, timeout: float = 600.0,
         try:
             rc = proc.wait(timeout=timeout)
         except subprocess.TimeoutExpired:
-            os.killpg(proc.pid, signal.SIGKILL)
-            proc.wait()
+            _kill(proc)
             raise CcxTimeoutError(f"ccx exceeded the {timeout:g} s wall-clock limit and was "
                                   "killed", "no result", deck, _last_sta_line(job)) from None
+        except BaseException:  # Ctrl-C and the like: do not leave ccx running
+            _kill(proc)
+            raise
     seconds = time.perf_counter() - t0
     log = log_path.read_text(errors="replace")
     err = _error_text(log)

@@ -64,14 +64,16 @@ def half_width_fit(state: ContactState, p0: float) -> tuple[float, float]:
     return math.sqrt(a_ / -b_), math.sqrt(a_)
 
 
-def stick_half_width(state: ContactState, ref: ContactState, p0: float,
-                     threshold: float) -> tuple[float, float]:
-    """Stick-zone half-width (m) and the node spacing there: contact nodes whose relative
-    tangential displacement since ``ref`` is below ``threshold`` (m) stick; the edge is put
-    midway between the outermost stick node and the next node on each side (averaged)."""
+def stick_half_width(state: ContactState, ref: ContactState, p0: float, mu: float,
+                     stick_slope: float) -> tuple[float, float]:
+    """Stick-zone half-width (m) and the node spacing there. A contact node slips when its
+    relative tangential displacement since ``ref`` exceeds the largest elastic displacement
+    its stick spring can take, mu p / stick_slope (p its pressure, stick_slope in Pa/m); the
+    stick-zone edge is put midway between the outermost stick node and the next node on each
+    side (averaged)."""
     on = in_contact(state, p0)
     slip = np.abs(state.slip - ref.slip)
-    stick = np.flatnonzero(on & (slip < threshold))
+    stick = np.flatnonzero(on & (slip <= mu * state.pressure / stick_slope))
     if stick.size == 0:
         return 0.0, float(np.diff(state.x).min())
     lo, hi = stick.min(), stick.max()
@@ -139,7 +141,6 @@ def tangential_checks(run: LineRun, ratios: tuple[float, ...] = (0.35, 0.55, 0.7
     compliance = (ds[0] - slip_displacement(qs[0], mu_p, e_star)) / qs[0]
     k_t = case.contact.stick_factor * case.contact.penalty_factor * min(
         case.lower.young, case.upper.young) / run.mesh.h_fine
-    threshold = 2.0 * mu * p0 / k_t  # twice the largest elastic displacement of a stick node
     used: set[int] = set()
     for target in ratios:
         cand = [j for j in range(1, steps.size) if j not in used and qs[j] / mu_p < 0.95]
@@ -149,7 +150,7 @@ def tangential_checks(run: LineRun, ratios: tuple[float, ...] = (0.35, 0.55, 0.7
         used.add(j)
         r = qs[j] / mu_p
         st = res.contact[int(steps[j])]
-        c, dx = stick_half_width(st, ref_state, p0, threshold)
+        c, dx = stick_half_width(st, ref_state, p0, mu, k_t)
         c_ref = a * math.sqrt(1.0 - r)
         out.append(check(f"mindlin_c (m) at Q/muP={r:.2f}", c, c_ref,
                          max(0.05 * c_ref, dx), absolute=True))
@@ -217,3 +218,26 @@ def validate_fe(folder: str | Path, threads: int = 1, timeout: float = 900.0,
                              timeout=timeout)
         out += plastic_onset_check(prun)
     return out
+
+
+def main(argv: list[str] | None = None) -> int:
+    """``python -m tribodem.contact.fe.validate [folder] [--threads N]``: run the checks,
+    print one JSON line each; exit status 1 if any fails."""
+    import argparse
+    import json
+    import tempfile
+
+    ap = argparse.ArgumentParser(description="closed-form checks of the ccx FE backend")
+    ap.add_argument("folder", nargs="?", help="keep the ccx jobs here (default: temporary)")
+    ap.add_argument("--threads", type=int, default=1)
+    ap.add_argument("--h-over-a", type=float, default=None)
+    args = ap.parse_args(argv)
+    with tempfile.TemporaryDirectory(prefix="tribodem_fe_") as tmp:
+        checks = validate_fe(args.folder or tmp, threads=args.threads, h_over_a=args.h_over_a)
+    for c in checks:
+        print(json.dumps(c))
+    return 0 if all(c["pass"] for c in checks) else 1
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
