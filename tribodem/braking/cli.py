@@ -14,18 +14,19 @@ Without ``--resume`` a run in ``--out`` is replaced. Ctrl-C exits 130 naming the
 and the checkpoint; an instability exits 3 after writing the rows so far and a summary with
 ``status = "stopped"``.
 
-A sweep runs each (condition, seed) member in its own folder; re-running the same sweep
-skips members whose summary.json is finished with the same config, resumes the others
-from their checkpoints and starts over those whose config changed. Ctrl-C cancels the
-pending members and kills the workers; a failed member is reported (comparison.md, stderr)
-and the comparison covers the others (exit 3).
+A sweep runs each (condition, packing) member as an independent task on Dask
+(``tribodem.braking.ensemble``: a local cluster of one-thread worker processes, or
+``--scheduler``), each in its own folder; re-running the same sweep skips members whose
+summary.json is finished with the same config, resumes the others from their checkpoints
+and starts over those whose config changed. Ctrl-C stops the members, closes the cluster
+and exits 130; a failed member is reported (comparison.md, stderr) and the comparison
+covers the others (exit 3).
 """
 
 from __future__ import annotations
 
 import json
 import time
-from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 from typing import Any, Literal
 
@@ -232,7 +233,7 @@ def _finished_summary(out: Path) -> dict[str, Any] | None:
 
 
 def _run_one(cfg_data: dict[str, Any], out: str, threads: int, resume: bool = False,
-             progress: bool = False) -> dict[str, Any]:
+             progress: bool = False, should_stop: Any = None) -> dict[str, Any]:
     """One run in ``out`` (the ``braking run`` command and each sweep worker): writes the
     resolved config.toml, then runs (``resume``: from ``out/checkpoint.npz``)."""
     import numba
@@ -252,7 +253,8 @@ def _run_one(cfg_data: dict[str, Any], out: str, threads: int, resume: bool = Fa
     own = o / "config.toml"
     if not (own.is_file() and own.read_text() == text):  # a resume leaves it untouched
         write_text(own, text)
-    return run_braking(setup, o, resume=resume, progress=progress, config=cfg.model_dump())
+    return run_braking(setup, o, resume=resume, progress=progress, config=cfg.model_dump(),
+                       should_stop=should_stop)
 
 
 @braking_app.command("run")
@@ -312,55 +314,22 @@ def braking_run(
     typer.echo(json.dumps({k: summary[k] for k in _SHOWN}, indent=2))
 
 
-def _member_plan(cfg_data: dict[str, Any], d: Path) -> tuple[str, Any]:
-    """What a sweep member needs: ("done", summary) when ``d`` holds its finished run with
-    the same config, ("resume", None) when it holds a usable checkpoint of it, else
-    ("new", why-not-reused or None)."""
-    from tribodem.braking.run import CHECKPOINT, read_checkpoint
+def _members(base: dict[str, Any], packings: int, out: Path) -> list[Any]:
+    """The sweep's members, each config checked (ConfigError) before anything is made.
+    Folders: ``condition_k`` with one packing, else ``condition_k/seed_s`` (packing s,
+    geometry seed ``seed + s``; the folder name is kept from the former ``--seeds``, so
+    earlier sweeps are skipped/resumed, not redone)."""
+    from tribodem.braking.ensemble import Member
 
-    new = validate(BrakingConfig, cfg_data, source="sweep").model_dump()
-    own = d / "config.toml"
-    if not own.is_file():
-        return "new", None
-    try:
-        old = validate(BrakingConfig, load_toml(own), source=str(own)).model_dump()
-    except ConfigError:
-        return "new", "its config.toml cannot be read"
-    diff = config_differences(old, new)
-    if diff:
-        return "new", f"{diff[0][0]} changed from {diff[0][1]!r} to {diff[0][2]!r}"
-    done = _finished_summary(d)
-    if done is not None:
-        return "done", done
-    ck = d / CHECKPOINT
-    if not ck.is_file():
-        return "new", None
-    try:
-        rec = read_checkpoint(ck)
-        ck_cfg = _checkpoint_config(rec, ck)
-    except ConfigError as err:
-        return "new", str(err)
-    if ck_cfg is not None and config_differences(ck_cfg, new):
-        return "new", "its checkpoint belongs to another config"
-    return "resume", None
-
-
-def _ignore_sigint() -> None:
-    """Sweep workers leave Ctrl-C to the main process, which stops them."""
-    import signal
-
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-
-
-def _stop_pool(ex: ProcessPoolExecutor) -> None:
-    """Cancel the pending members and kill the worker processes now."""
-    procs = list((getattr(ex, "_processes", None) or {}).values())
-    ex.shutdown(wait=False, cancel_futures=True)
-    for pr in procs:
-        if pr.is_alive():
-            pr.kill()
-    for pr in procs:
-        pr.join(timeout=5)
+    seed0 = int(base["geometry"]["seed"])
+    members = []
+    for s in range(packings):
+        for k in range(1, 6):
+            data = merge(base, {"condition": {"index": k}, "geometry": {"seed": seed0 + s}})
+            setup_from_config(validate(BrakingConfig, data, source="sweep"))
+            d = out / f"condition_{k}" if packings == 1 else out / f"condition_{k}" / f"seed_{s}"
+            members.append(Member(k, s, data, d))
+    return members
 
 
 @braking_app.command("sweep")
@@ -370,87 +339,97 @@ def braking_sweep(
     config: Path | None = typer.Option(None, "--config", help="TOML config (condition ignored)."),
     quick: bool = typer.Option(False, "--quick", help="Small, fast variant (< 3 min); it "
                                "overrides the config file."),
-    workers: int = typer.Option(2, "--workers", min=1, max=64, help="Parallel processes."),
-    seeds: int = typer.Option(1, "--seeds", min=1, max=100,
-                              help="Packing/roughness realisations per condition (averaged)."),
+    packings: int | None = typer.Option(
+        None, "--packings", min=1, max=1000,
+        help="Packing/roughness realisations per condition (geometry seeds seed, seed+1, "
+             "...); changes are paired over them. Default 1."),
+    seeds: int | None = typer.Option(None, "--seeds", min=1, max=1000, hidden=True,
+                                     help="Deprecated alias of --packings."),
+    workers: int = typer.Option(
+        0, "--workers", min=0, max=1024,
+        help="Worker processes of the local Dask cluster (1 thread each); 0 = all local "
+             "cores. Not with --scheduler."),
+    scheduler: str | None = typer.Option(
+        None, "--scheduler",
+        help="Use an existing Dask cluster: tcp://HOST:PORT of its scheduler (dask "
+             "scheduler / dask worker, dask-jobqueue, Kubernetes) or its scheduler JSON "
+             "file; --out must be on a file system the workers share."),
     progress: bool = typer.Option(True, "--progress/--no-progress",
-                                  help="Progress bar (members done / total) on stderr."),
+                                  help="Progress bar (members done / running / failed) on "
+                                       "stderr."),
 ) -> None:
-    """Conditions 1-5 in parallel: comparison.csv, comparison.md (ours beside the seed's).
+    """Conditions 1-5 x --packings on Dask: comparison.md, comparison.json, comparison.csv
+    (ours with paired 95% intervals beside the seed's).
 
-    Each (condition, seed) member runs in its own folder with its own checkpoints; a
-    re-run with the same --out skips the finished members, resumes the unfinished ones
-    and starts over those whose config changed. A failed member is reported and left out
-    of the comparison (exit 3 at the end)."""
-    from concurrent.futures import as_completed
-
+    Each (condition, packing) member is an independent, idempotent task with its own
+    folder and checkpoints; a re-run with the same --out skips the finished members,
+    resumes the unfinished ones and starts over those whose config changed. A worker lost
+    mid-member: the scheduler reschedules the member, which resumes from its checkpoint. A
+    failed member is reported and left out of the comparison (exit 3 at the end)."""
     from tribodem.braking.compare import write_comparison
+    from tribodem.braking.ensemble import check_scheduler, member_plan, run_members
     from tribodem.io import runs
     from tribodem.io.runs import RunStopped
 
+    if seeds is not None:
+        typer.echo("warning: --seeds is deprecated: it counts packing/roughness "
+                   "realisations; use --packings", err=True)
+        if packings is not None and packings != seeds:
+            raise ConfigError(f"braking sweep: --seeds = {seeds} (deprecated alias of "
+                              f"--packings) contradicts --packings = {packings}; allowed: "
+                              "give --packings only")
+    n_pack = packings or seeds or 1
+    if scheduler is not None and workers:
+        raise ConfigError(f"braking sweep: --workers = {workers}: sets the local cluster's "
+                          "size, so it cannot go with --scheduler (the cluster there has "
+                          "its own workers); allowed: one of the two")
+    if scheduler is not None:
+        check_scheduler(scheduler)
     base = _config(None, config, quick).model_dump()
     base["condition"] = {}
-    seed0 = int(base["geometry"]["seed"])
     t0 = time.perf_counter()
-    members: list[tuple[int, int, dict[str, Any], Path]] = []
-    for s in range(seeds):
-        for k in range(1, 6):
-            data = merge(base, {"condition": {"index": k}, "geometry": {"seed": seed0 + s}})
-            setup_from_config(validate(BrakingConfig, data, source="sweep"))
-            d = out / f"condition_{k}" if seeds == 1 else out / f"condition_{k}" / f"seed_{s}"
-            members.append((k, s, data, d))
+    members = _members(base, n_pack, out)
     runs.check_out_dir(out, "--out")  # every member checked first: no folder for a bad one
     runs.announce(out)
     results: dict[tuple[int, int], dict[str, Any]] = {}
-    failed: dict[tuple[int, int], str] = {}
     todo = []
-    for k, s, data, d in members:
-        what, info = _member_plan(data, d)
-        name = d.relative_to(out)
+    for m in members:
+        what, info = member_plan(m.data, m.folder)
+        name = m.folder.relative_to(out)
         if what == "done":
-            results[(k, s)] = info
+            results[m.key] = info
             typer.echo(f"  {name}: finished earlier, skipped")
         else:
             if what == "resume":
                 typer.echo(f"  {name}: resuming from its checkpoint")
             elif info:
                 typer.echo(f"  {name}: starting over ({info})")
-            todo.append((k, s, data, d, what == "resume"))
+            todo.append(m)
+    failed: dict[tuple[int, int], str] = {}
+    where = "nothing to run"
     if todo:
-        ex = ProcessPoolExecutor(max_workers=min(workers, len(todo)),
-                                 initializer=_ignore_sigint)
         try:
-            futs = {ex.submit(_run_one, data, str(d), 1, res): (k, s)
-                    for k, s, data, d, res in todo}
-            with runs.progress(len(members), "run", "braking sweep", enabled=progress,
-                               initial=len(results)) as bar:
-                for f in as_completed(futs):
-                    key = futs[f]
-                    try:
-                        results[key] = f.result()
-                    except Exception as err:  # noqa: BLE001 - reported, the rest go on
-                        failed[key] = f"{type(err).__name__}: {err}"
-                        typer.echo(f"  condition {key[0]} seed {key[1]}: failed: "
-                                   f"{failed[key]}", err=True)
-                    bar.update(1)
-        except BaseException:  # Ctrl-C (or anything): stop the workers now, then re-raise
-            _stop_pool(ex)
+            done, failed, where = run_members(
+                todo, len(members), len(results), scheduler=scheduler, workers=workers,
+                progress=progress, echo=lambda s: typer.echo(s, err=True))
+        except BaseException:
             typer.echo("\nsweep stopped: finished members are kept; run the same command "
                        "again to skip them and resume the others from their checkpoints",
                        err=True)
             raise
-        ex.shutdown(wait=True)
+        results.update(done)
     wall = time.perf_counter() - t0
     runs_by_k: dict[int, list[tuple[dict[str, Any], Path]]] = {}
-    for k, s, _data, d in members:
-        if (k, s) in results:
-            runs_by_k.setdefault(k, []).append((results[(k, s)], d))
-    fails = {f"condition {k} seed {s}": msg for (k, s), msg in sorted(failed.items())}
-    rows = write_comparison(out, runs_by_k, wall, workers, quick, failed=fails) \
+    for m in members:
+        if m.key in results:
+            runs_by_k.setdefault(m.condition, []).append((results[m.key], m.folder))
+    fails = {f"condition {k} packing {s}": msg for (k, s), msg in sorted(failed.items())}
+    rows = write_comparison(out, runs_by_k, wall, where, quick, failed=fails) \
         if runs_by_k else []
     skipped = len(members) - len(todo)
-    typer.echo(f"sweep: 5 conditions x {seeds} seed(s) in {wall:.1f} s on {workers} workers "
-               f"({len(todo)} run, {skipped} skipped as finished) -> {out / 'comparison.md'}")
+    typer.echo(f"sweep: 5 conditions x {n_pack} packing(s) in {wall:.1f} s on {where} "
+               f"({len(todo)} run, {skipped} skipped as finished, {len(failed)} failed) "
+               f"-> {out / 'comparison.md'}")
     for r in rows:
         typer.echo(f"  {r[0]}: ours {r[1]}, seed {r[2]}")
     if failed:

@@ -9,7 +9,7 @@ from typing import Any
 import numpy as np
 
 from tribodem.braking.conditions import CONDITIONS, SEED_BRAKING_TIME_S
-from tribodem.io.results import write_csv, write_text
+from tribodem.io.results import write_csv, write_json, write_text
 
 #: seed 000 section 5: (from, to, wear depth change %, force chain change %)
 SEED_CHANGES = [
@@ -118,8 +118,31 @@ def _pm(pct: float, se: float) -> str:
     return _fmt(pct) if not np.isfinite(se) else f"{pct:+.1f} +- {se:.1f}%"
 
 
+def ci95(se: float, n: int) -> float:
+    """Half-width (percentage points) of the two-sided 95% Student-t interval of a paired
+    change over n packings with standard error ``se`` (nan with one packing)."""
+    return _factor(n) * se if np.isfinite(se) and n >= 2 else float("nan")
+
+
+def seed_inside(seed_pct: float | None, pct: float, half: float) -> bool | None:
+    """The rule of ``reproduced``: the seed's change lies inside our paired 95% interval,
+    ``|seed - ours| <= ci95``; None when there is no interval (one packing) or no seed
+    value."""
+    if seed_pct is None or not (np.isfinite(half) and np.isfinite(pct)):
+        return None
+    return bool(abs(seed_pct - pct) <= half)
+
+
+def _ci(pct: float, half: float) -> str:
+    return _fmt(pct) if not np.isfinite(half) else f"{pct:+.1f} +- {half:.1f}%"
+
+
+def _num(x: float) -> float | None:
+    return float(x) if x is not None and np.isfinite(x) else None
+
+
 def write_comparison(out: Path, runs: dict[int, list[tuple[dict[str, Any], Path]]],
-                     wall_s: float, workers: int, quick: bool,
+                     wall_s: float, cluster: str | int, quick: bool,
                      failed: dict[str, str] | None = None) -> list[tuple[str, str, str]]:
     """Write comparison.csv and comparison.md from the runs of each condition (one per
     packing seed): seed means, the standard error of each change over seeds, and a
@@ -161,19 +184,37 @@ def write_comparison(out: Path, runs: dict[int, list[tuple[dict[str, Any], Path]
     rows_csv = []
     lines = []
     printed = []
+    trends_json = []
     for label, a, b, seed_w, seed_c in SEED_CHANGES:
         (ow, ow_se), (orr, orr_se) = ch["wear"][(a, b)], ch["rate"][(a, b)]
         (oc, oc_se), (os_, _) = ch["chains"][(a, b)], ch["strong"][(a, b)]
+        hw, hr, hc = (ci95(x, n_seeds) for x in (ow_se, orr_se, oc_se))
         rows_csv.append([label, a, b, n_seeds, wear[a], wear[b], ow, ow_se,
                          step_verdict(ow, ow_se, n_seeds), seed_w, rate[a], rate[b], orr, orr_se,
                          step_verdict(orr, orr_se, n_seeds), chains[a], chains[b], oc, oc_se,
-                         "" if seed_c is None else seed_c, os_])
+                         "" if seed_c is None else seed_c, os_, hw, hr, hc])
+        inside_w, inside_c = seed_inside(seed_w, ow, hw), seed_inside(seed_c, oc, hc)
+
+        def yes(x: bool | None) -> str:
+            return "-" if x is None else ("yes" if x else "no")
+
         lines.append(f"| {label} | {a}->{b} | {wear[a] * 1e6:.2f} -> {wear[b] * 1e6:.2f} | "
-                     f"{_pm(ow, ow_se)} | {step_verdict(ow, ow_se, n_seeds)} | {_fmt(seed_w)} | "
-                     f"{_pm(orr, orr_se)} | {step_verdict(orr, orr_se, n_seeds)} | "
-                     f"{chains[a]:.0f} -> {chains[b]:.0f} | {_pm(oc, oc_se)} | "
-                     f"{_fmt(seed_c)} |")
-        printed.append((label, _pm(ow, ow_se), _fmt(seed_w)))
+                     f"{_ci(ow, hw)} | {_fmt(seed_w)} | {yes(inside_w)} | "
+                     f"{step_verdict(ow, ow_se, n_seeds)} | "
+                     f"{_ci(orr, hr)} | {step_verdict(orr, orr_se, n_seeds)} | "
+                     f"{chains[a]:.0f} -> {chains[b]:.0f} | {_ci(oc, hc)} | "
+                     f"{_fmt(seed_c)} | {yes(inside_c)} |")
+        printed.append((label, _ci(ow, hw), _fmt(seed_w)))
+        for q, seed_pct, pct, half, inside, se in (
+                ("wear_depth", seed_w, ow, hw, inside_w, ow_se),
+                ("force_chains", seed_c, oc, hc, inside_c, oc_se)):
+            if seed_pct is None:
+                continue
+            trends_json.append({
+                "change": label, "from_condition": a, "to_condition": b, "quantity": q,
+                "seed_pct": seed_pct, "ours_pct": _num(pct), "ci95_pct": _num(half),
+                "se_pct": _num(se), "reproduced": inside,
+                "resolved": None if not np.isfinite(half) else bool(abs(pct) > half)})
     write_csv(out / "comparison.csv",
               ["change", "from_condition", "to_condition", "seeds", "wear_depth_from_m",
                "wear_depth_to_m", "wear_depth_change_pct", "wear_depth_change_se_pct",
@@ -181,7 +222,9 @@ def write_comparison(out: Path, runs: dict[int, list[tuple[dict[str, Any], Path]
                "wear_rate_to_m_s", "wear_rate_change_pct", "wear_rate_change_se_pct",
                "wear_rate_verdict", "force_chains_from", "force_chains_to",
                "force_chains_change_pct", "force_chains_change_se_pct",
-               "seed_force_chains_change_pct", "strong_force_chains_change_pct"], rows_csv)
+               "seed_force_chains_change_pct", "strong_force_chains_change_pct",
+               "wear_depth_change_ci95_pct", "wear_rate_change_ci95_pct",
+               "force_chains_change_ci95_pct"], rows_csv)
 
     def trend(q: str, ks: tuple[int, int, int], want: str) -> str:
         a, b, c = ks
@@ -240,7 +283,7 @@ def write_comparison(out: Path, runs: dict[int, list[tuple[dict[str, Any], Path]
                "and roughness (only load and speed differ), so changes are paired: the "
                "error is that of the mean per-seed difference." if rel else
                "One packing per condition: the scatter between packings is not measured "
-               "here (use --seeds N), so no change can be called resolved.")
+               "here (use --packings N), so no change can be called resolved.")
     extrap = (
         f"Our linear extrapolation to 8 s (steady rate over the second half, clipped at "
         f"0): {r5['wear_depth_mean_extrapolated_8s_m'] * 1e3:.3g} mm "
@@ -253,7 +296,8 @@ def write_comparison(out: Path, runs: dict[int, list[tuple[dict[str, Any], Path]
         "# Braking sweep: tribodem vs seed 000" + (" (--quick)" if quick else ""),
         "",
         f"5 conditions (table 4) x {n_seeds} packing/roughness seed(s) in {wall_s:.0f} s on "
-        f"{workers} worker processes; values are seed means +- the standard deviation over "
+        f"{cluster if isinstance(cluster, str) else f'{cluster} worker processes'}; values "
+        "are means over packings +- the standard deviation over "
         f"seeds. Every run simulates {t_sim * 1e6:.3g} us of sliding (the same braking time "
         "for all conditions, as the seed compares at 8 s); the seed's 8 s are not "
         f"simulated (fraction {t_sim / SEED_BRAKING_TIME_S:.2e}). Wear depth = mean pad "
@@ -272,12 +316,19 @@ def write_comparison(out: Path, runs: dict[int, list[tuple[dict[str, Any], Path]
         "",
         f"Pad wear depth per seed (um), condition: values -- {seeds_txt}.",
         "",
-        "## Changes: ours (mean change +- standard error) beside the seed's (section 5)",
+        "## Changes: ours (mean change +- paired 95% interval) beside the seed's (section 5)",
         "",
-        "| change | conditions | our wear depth um | our wear change | verdict | "
-        "seed wear change | our wear-rate change | verdict | our force chains | "
-        "our chain change | seed chain change |",
-        "|---|---|---|---|---|---|---|---|---|---|---|",
+        f"Our change = change of the means over {n_seeds} packing(s) +- the half-width of "
+        "the two-sided 95% Student-t interval of the paired per-packing changes "
+        f"({_factor(n_seeds):.2f} standard errors, {max(n_seeds - 1, 0)} degrees of freedom). "
+        "'seed inside' (comparison.json `reproduced`): the seed's change lies inside our "
+        "interval, |seed - ours| <= half-width; 'verdict': our interval excludes 0 "
+        "(up/down) or not (not resolved).",
+        "",
+        "| change | conditions | our wear depth um | our wear change (95%) | seed wear change "
+        "| seed inside | verdict | our wear-rate change (95%) | verdict | our force chains | "
+        "our chain change (95%) | seed chain change | seed inside |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|",
         *lines,
         "",
         "## Trends",
@@ -303,4 +354,17 @@ def write_comparison(out: Path, runs: dict[int, list[tuple[dict[str, Any], Path]
         *fail_lines,
     ])
     write_text(out / "comparison.md", text)
+    write_json(out / "comparison.json", {
+        "packings": n_seeds,
+        "conditions": {str(k): len(v) for k, v in sorted(runs.items())},
+        "rule": "ours_pct = relative change of the means over packings; ci95_pct = half-width "
+                "(percentage points) of the two-sided 95% Student-t interval of the paired "
+                "per-packing changes (t(0.975, n-1) x se); reproduced = |seed_pct - ours_pct| "
+                "<= ci95_pct (null with one packing); resolved = |ours_pct| > ci95_pct",
+        "trends": trends_json,
+        "verdicts": {w: v for w, v in verdicts},
+        "failed": dict(failed or {}),
+        "wall_time_s": wall_s,
+        "cluster": str(cluster),
+    })
     return printed

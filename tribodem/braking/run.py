@@ -32,6 +32,7 @@ from __future__ import annotations
 import json
 import math
 import time
+from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
@@ -248,8 +249,8 @@ def wear_extrapolation(t: np.ndarray, h: np.ndarray, target_s: float) -> tuple[f
 
 
 def run_braking(setup: RunSetup, out: Path | None = None, *, resume: bool = False,
-                progress: bool = False, config: dict[str, Any] | None = None
-                ) -> dict[str, Any]:
+                progress: bool = False, config: dict[str, Any] | None = None,
+                should_stop: Callable[[], bool] | None = None) -> dict[str, Any]:
     """Run one braking interface simulation; write results to ``out`` (if given) and
     return the summary dict.
 
@@ -261,6 +262,8 @@ def run_braking(setup: RunSetup, out: Path | None = None, *, resume: bool = Fals
     An instability (``RunStopped``) is re-raised after the rows so far and a summary with
     ``status = "stopped"`` are written. ``progress``: a bar over the sliding steps.
     ``config``: the command's resolved config (JSON-able), kept in the checkpoint.
+    ``should_stop``: polled after every sample (a sweep's stop event); when it says yes the
+    run writes a checkpoint and stops (``RunStopped``), to be resumed later.
     """
     for name, v in (("pressure_Pa", setup.pressure_Pa), ("speed_m_s", setup.speed_m_s),
                     ("duration_s", setup.duration_s)):
@@ -415,6 +418,10 @@ def run_braking(setup: RunSetup, out: Path | None = None, *, resume: bool = Fals
                     write_rows()
                 elif time.monotonic() - last_csv > 2.0:
                     write_rows()
+                if should_stop is not None and should_stop():
+                    save_checkpoint()
+                    raise RunStopped("stopped by its sweep (the sweep was interrupted); "
+                                     "the checkpoint resumes it")
     except RunStopped as err:
         if out is not None:
             write_rows()
