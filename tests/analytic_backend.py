@@ -39,6 +39,7 @@ class AnalyticHertzSolver(FirstBodySolver):
         self.load, self.friction, self.n = float(load), float(friction), int(n)
         e_star = contact_modulus(upper_material or ElasticBody(),
                                  lower_material or ElasticBody())
+        self.modulus = e_star
         self.hertz = HertzSphere(radius, self.load, e_star)
         self.dx = (window or 10 * self.hertz.contact_radius) / self.n
         self.reset()

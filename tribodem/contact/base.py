@@ -172,7 +172,8 @@ class FirstBodySolver(ABC):
     relative tangential position at a time, in path order (the solver may keep load history
     between calls). The contract:
 
-    - data: ``n``, ``dx`` (window grid), ``load`` (N), ``upper``/``lower`` (recessions, m:
+    - data: ``n``, ``dx`` (window grid), ``load`` (N), ``modulus`` (E*, Pa),
+      ``upper``/``lower`` (recessions, m:
       the surfaces the next solve sees), ``capabilities``;
     - :meth:`set_surfaces` (worn geometry), :meth:`reset`, :meth:`begin_cycle`,
       :meth:`solve_increment`;
@@ -191,6 +192,8 @@ class FirstBodySolver(ABC):
     n: int
     #: normal load, N
     load: float
+    #: contact modulus E* of the two bodies, Pa (the scale of elastic deformation)
+    modulus: float
     #: recessions of the two surfaces (m), as the next solve sees them
     upper: Recession
     lower: Recession

@@ -135,6 +135,10 @@ def _scar_mean(w: NDArray[np.float64]) -> float:
     return float(w[worn].mean()) if worn.any() else 0.0
 
 
+#: Default of ``FrettingLoop(geometry_tolerance=...)`` (docs/fretting.md, "Jumping").
+GEOMETRY_TOLERANCE = 0.05
+
+
 class FrettingLoop:
     """Fretting wear loop on a first-body solver with worn-surface geometry update.
 
@@ -156,6 +160,7 @@ class FrettingLoop:
         strategy: JumpStrategy | None = None,
         debris: DebrisField | None = None,
         debris_every: int = 1,
+        geometry_tolerance: float | None = GEOMETRY_TOLERANCE,
     ) -> None:
         criterion.check_solver(solver)
         if debris is not None:
@@ -187,6 +192,11 @@ class FrettingLoop:
         self._observe_pending = False  # last cycle of a finished run not shown to strategy
         self._last_per: dict[str, Any] = {}  # per-cycle values of the last simulated cycle
         self._wall = 0.0  # wall time of earlier sessions (resumed runs), s
+        #: jumps keep the geometry the next cycle sees: the jumped depth increment stays
+        #: below this fraction of the contact's elastic approach (None: strategy alone)
+        self.geometry_tolerance: float | None = geometry_tolerance
+        self._last_du = np.zeros((n, n))
+        self._last_dl = np.zeros((self.grid.n_track, n))
 
     def _de_phase(self) -> dict[str, float]:
         """Seed 003 figure 3.1 DE step: load the debris, map its forces back to the solver."""
@@ -269,6 +279,7 @@ class FrettingLoop:
             raise RuntimeError(f"criterion '{crit.name}' returned a negative wear depth")
         self.wear_upper = self.wear_upper + du
         self.wear_lower = self.wear_lower + dl
+        self._last_du, self._last_dl = du, dl
         self._generate_debris(du, dl)
         if self.debris is not None:
             extra |= {"debris_particles": self.debris.n,
@@ -322,7 +333,7 @@ class FrettingLoop:
         reached."""
         assert self.strategy is not None and self.history is not None
         self.strategy.observe(c, self._state())
-        n = min(int(self.strategy.propose_jump()), cycles - c)
+        n = min(int(self.strategy.propose_jump()), cycles - c, self._geometry_limit(per))
         if n <= 0:
             return c
         old = self._state()
@@ -341,6 +352,22 @@ class FrettingLoop:
             self._record(self._row(c + k, True, per), progress)
         self.history.cycles_jumped += n
         return c + n
+
+    def _geometry_limit(self, per: dict[str, Any]) -> int:
+        """Longest jump the geometry allows (None: no limit): the jumped depth increment,
+        anywhere on either body, at most ``geometry_tolerance`` x the contact's elastic
+        approach, so the pressure the next cycle sees moves little over a jump.
+
+        The approach of the last simulated cycle's contact, 3 P / (4 a E*) with a the radius
+        of its mean contact area (Hertz: a^2 / R), is the scale on which a change of the
+        gap changes the pressure by its own order; the depth increment is that cycle's."""
+        tol = self.geometry_tolerance
+        inc = max(float(self._last_du.max(initial=0.0)), float(self._last_dl.max(initial=0.0)))
+        if tol is None or inc <= 0.0:
+            return 1 << 62
+        a = math.sqrt(max(float(per.get("contact_area_m2", 0.0)), self.grid.cell_area) / math.pi)
+        approach = 3.0 * self.solver.load / (4.0 * a * self.solver.modulus)
+        return int(tol * approach / inc)
 
     @property
     def cycles_done(self) -> int:
