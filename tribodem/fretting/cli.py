@@ -36,7 +36,7 @@ from tribodem.fretting.criteria import (
     make_criterion,
 )
 from tribodem.fretting.debris import DebrisField, DebrisSettings
-from tribodem.fretting.loop import FrettingHistory, FrettingLoop
+from tribodem.fretting.loop import GEOMETRY_TOLERANCE, FrettingHistory, FrettingLoop
 from tribodem.fretting.output import (
     CHECKPOINT,
     read_checkpoint,
@@ -126,8 +126,14 @@ class PlasticConfig(_Model):
 
 
 class JumpConfig(_Model):
+    """Cycle-jumping: a strategy of seed 003 chapter 4 and its parameters, capped by the
+    loop's geometry control (docs/fretting.md, "Jumping")."""
+
     strategy: JumpName = "none"
     params: dict[str, Any] = Field(default_factory=dict)
+    geometry_tolerance: float = Field(
+        GEOMETRY_TOLERANCE, ge=0, description="largest jumped depth increment / the "
+        "contact's elastic approach (0: the strategy alone)")
 
 
 class DebrisConfig(_Model):
@@ -320,7 +326,8 @@ def build_loop(cfg: FrettingConfig) -> FrettingLoop:
     try:
         return FrettingLoop(solver, crit, amplitude=c.amplitude, n_increments=c.n_increments,
                             strategy=strategy, debris=debris,
-                            debris_every=cfg.debris.every or 1)
+                            debris_every=cfg.debris.every or 1,
+                            geometry_tolerance=cfg.jump.geometry_tolerance or None)
     except ValueError as err:  # CriterionUnavailable included
         raise ConfigError(f"wear: {err}") from None
 

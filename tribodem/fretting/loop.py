@@ -393,6 +393,7 @@ class FrettingLoop:
             "observe_pending": self._observe_pending, "last_per": dict(self._last_per),
             "wall_time_s": hist.wall_time_s,
             "wear_upper": self.wear_upper.copy(), "wear_lower": self.wear_lower.copy(),
+            "last_du": self._last_du.copy(), "last_dl": self._last_dl.copy(),
             "p_load": np.asarray(self._p_load, dtype=float).copy(),
             "solver": self.solver.state_dict(),
             "criterion": self.criterion.state(),
@@ -418,6 +419,8 @@ class FrettingLoop:
                 raise ValueError(f"saved {name} has shape {got}, this loop {have}")
         self.wear_upper = np.array(state["wear_upper"], dtype=float)
         self.wear_lower = np.array(state["wear_lower"], dtype=float)
+        self._last_du = np.array(state["last_du"], dtype=float)
+        self._last_dl = np.array(state["last_dl"], dtype=float)
         self._p_load = np.array(state["p_load"], dtype=float)
         self._cycle = int(state["cycle"])
         self._done = int(state["done"])
