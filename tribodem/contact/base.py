@@ -126,6 +126,8 @@ class Capabilities:
     """What a first-body backend can give; criteria and the loop check it before any work.
 
     ``plastic``: equivalent plastic strain increments (:meth:`FirstBodySolver.plastic_steps`);
+    ``plastic_every_cycle``: plastic strain solved in every cycle, not only at the first
+    loading (what accumulating criteria such as DFDI need over more than one cycle);
     ``partial_slip``: stick/slip inside the contact (else gross slip q = mu p everywhere);
     ``subsurface``: stress below the surface (:meth:`FirstBodySolver.subsurface_stress`);
     ``debris``: a prescribed extra surface pressure (the debris third body);
@@ -133,6 +135,7 @@ class Capabilities:
     """
 
     plastic: bool = False
+    plastic_every_cycle: bool = False
     partial_slip: bool = False
     subsurface: bool = True
     debris: bool = False
@@ -140,13 +143,16 @@ class Capabilities:
 
     def names(self) -> set[str]:
         """The capabilities that hold, by name (``plastic``, ``subsurface``, ...)."""
-        return {k for k in ("plastic", "partial_slip", "subsurface", "debris")
+        return {k for k in ("plastic", "plastic_every_cycle", "partial_slip", "subsurface",
+                            "debris")
                 if getattr(self, k)} | {f"{c}_contact" for c in self.contacts}
 
 
 #: What each capability name means (for messages).
 CAPABILITY_TEXT = {
     "plastic": "plastic (the equivalent plastic strain)",
+    "plastic_every_cycle": "plastic_every_cycle (plastic strain solved in every cycle, not "
+                           "only at the first loading)",
     "partial_slip": "partial_slip (stick and slip inside the contact)",
     "subsurface": "subsurface (the stress below the surface)",
     "debris": "debris (a prescribed debris pressure)",

@@ -268,7 +268,11 @@ def check_compatible(cfg: FrettingConfig) -> None:
     chosen first-body backend cannot give, naming both and the backends that would do."""
     backend = BACKENDS[cfg.solver]
     have = backend.capabilities.names()
-    needs = [(f"wear.criterion = {cfg.wear.criterion!r}", CRITERIA[cfg.wear.criterion].requires)]
+    crit = CRITERIA[cfg.wear.criterion]
+    needs = [(f"wear.criterion = {cfg.wear.criterion!r}", crit.requires)]
+    if cfg.cycles > 1 and crit.requires_over_cycles:
+        needs.append((f"wear.criterion = {cfg.wear.criterion!r} over cycles = {cfg.cycles} "
+                      "(allowed with this solver: cycles = 1)", crit.requires_over_cycles))
     if cfg.debris.every is not None:
         needs.append(("debris.every (the debris third body)", frozenset({"debris"})))
     for who, req in needs:

@@ -159,6 +159,8 @@ class Criterion(ABC):
     kind: ClassVar[str] = "rate"  #: "rate" or "threshold"
     #: first-body capabilities it needs (:class:`tribodem.contact.Capabilities` names)
     requires: ClassVar[frozenset[str]] = frozenset()
+    #: what it needs besides ``requires`` in a run of more than one cycle
+    requires_over_cycles: ClassVar[frozenset[str]] = frozenset()
     #: attributes not carried from one cycle to the next (remade by :meth:`begin_cycle`),
     #: left out of :meth:`state`
     _SCRATCH: ClassVar[frozenset[str]] = frozenset(
@@ -489,6 +491,7 @@ class DFDICriterion(Criterion):
     name = "dfdi"
     kind = "threshold"
     requires = frozenset({"plastic"})
+    requires_over_cycles = frozenset({"plastic_every_cycle"})
 
     def __init__(self, eps0: float = 0.132, depth: float | None = None, nz: int = 33) -> None:
         if not (math.isfinite(eps0) and eps0 > 0):

@@ -463,6 +463,12 @@ class FrettingLoop:
         """
         if int(cycles) != cycles or cycles < 1:
             raise ValueError(f"cycles = {cycles!r} is not allowed: must be an integer >= 1")
+        if cycles > 1:
+            try:
+                require(self.solver, self.criterion.requires_over_cycles,
+                        f"criterion '{self.criterion.name}' over {cycles} cycles")
+            except ValueError as err:
+                raise CriterionUnavailable(str(err)) from None
         if int(checkpoint_every) != checkpoint_every or checkpoint_every < 1:
             raise ValueError(f"checkpoint_every = {checkpoint_every!r} is not allowed: must "
                              "be an integer >= 1")
