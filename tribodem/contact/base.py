@@ -29,6 +29,8 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import NDArray
 
+from tribodem.materials.en24t import EN24T
+
 #: A body's recession below its tangent plane at (x, y), m (callable or height map).
 Recession = Callable[[NDArray[np.float64], NDArray[np.float64]], NDArray[np.float64]]
 
@@ -52,8 +54,8 @@ def _check_positive(name: str, value: float, allow_zero: bool = False) -> float:
 class ElasticBody:
     """Isotropic elastic first body; defaults are EN24T (seed table 5.1: E 240 GPa, nu 0.3)."""
 
-    young: float = 240e9  #: Young's modulus, Pa
-    poisson: float = 0.3  #: Poisson's ratio, -
+    young: float = EN24T.young  #: Young's modulus, Pa
+    poisson: float = EN24T.poisson  #: Poisson's ratio, -
 
     def __post_init__(self) -> None:
         _check_positive("young", self.young)

@@ -58,12 +58,13 @@ from tribodem.contact.halfspace import (
     model_fields,
     set_model_fields,
 )
+from tribodem.materials.en24t import EN24T
 
 #: EN24T (seed table 5.1): yield and ultimate tensile strength, Pa.
-YIELD_EN24T = 680e6
-UTS_EN24T = 1000e6
+YIELD_EN24T = EN24T.yield_strength
+UTS_EN24T = EN24T.uts
 #: Engineering strain at the UTS implied by seed table 6.2 (true 1132 MPa = 1000 (1 + e)).
-UTS_STRAIN_EN24T = 0.132
+UTS_STRAIN_EN24T = EN24T.uts_strain
 
 
 def bilinear_hardening(young: float, yield_strength: float, uts: float, uts_strain: float) -> float:

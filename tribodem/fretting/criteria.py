@@ -34,12 +34,13 @@ import numpy as np
 from numpy.typing import NDArray
 
 from tribodem.contact.base import FirstBodySolver, IncrementResult, SubsurfaceStress, require
+from tribodem.materials.en24t import EN24T
 
 #: Fouvry energy wear coefficient of the seed (section 5.2), 1.641e-6 mm^3/J, in m^3/J.
-ALPHA_SEED = 1.641e-6 * 1e-9
+ALPHA_SEED = EN24T.energy_wear_coefficient
 #: EN24T yield and ultimate tensile strength (seed table 5.1), Pa.
-YIELD_EN24T = 680e6
-UTS_EN24T = 1000e6
+YIELD_EN24T = EN24T.yield_strength
+UTS_EN24T = EN24T.uts
 
 
 class CriterionUnavailable(ValueError):
@@ -493,7 +494,8 @@ class DFDICriterion(Criterion):
     requires = frozenset({"plastic"})
     requires_over_cycles = frozenset({"plastic_every_cycle"})
 
-    def __init__(self, eps0: float = 0.132, depth: float | None = None, nz: int = 33) -> None:
+    def __init__(self, eps0: float = EN24T.uts_strain, depth: float | None = None,
+                 nz: int = 33) -> None:
         if not (math.isfinite(eps0) and eps0 > 0):
             raise ValueError(f"eps0 = {eps0!r} is not allowed: must be > 0 (failure strain)")
         _check_stress_grid(depth, nz)
@@ -570,7 +572,7 @@ class DFDICriterion(Criterion):
 
 
 #: Seed table 6.2 (SWT, Mitchell method): b, sigma'_f (Pa), sigma_T (Pa), eps'_f, c.
-SWT_TABLE_6_2 = {"b": -0.103, "sigma_f": 2349e6, "sigma_t": 1132e6, "eps_f": 1.22, "c": -0.6}
+SWT_TABLE_6_2 = dict(EN24T.swt)
 
 
 def swt_rhs(two_n: NDArray[np.float64] | float, young: float, b: float, sigma_f: float,
@@ -580,7 +582,7 @@ def swt_rhs(two_n: NDArray[np.float64] | float, young: float, b: float, sigma_f:
     return sigma_f**2 / young * x ** (2 * b) + sigma_f * eps_f * x ** (b + c)
 
 
-def swt_life(swt: NDArray[np.float64] | float, young: float = 240e9,
+def swt_life(swt: NDArray[np.float64] | float, young: float = EN24T.young,
              b: float = SWT_TABLE_6_2["b"], sigma_f: float = SWT_TABLE_6_2["sigma_f"],
              eps_f: float = SWT_TABLE_6_2["eps_f"], c: float = SWT_TABLE_6_2["c"]
              ) -> NDArray[np.float64]:
@@ -653,8 +655,9 @@ class SWTCriterion(ThresholdCriterion):
     name = "swt"
     unit = "-"
 
-    def __init__(self, young: float = 240e9, poisson: float = 0.3, b: float = -0.103,
-                 sigma_f: float = 2349e6, eps_f: float = 1.22, c: float = -0.6,
+    def __init__(self, young: float = EN24T.young, poisson: float = EN24T.poisson,
+                 b: float = SWT_TABLE_6_2["b"], sigma_f: float = SWT_TABLE_6_2["sigma_f"],
+                 eps_f: float = SWT_TABLE_6_2["eps_f"], c: float = SWT_TABLE_6_2["c"],
                  plane_step: float = 5.0, nz: int = 17, **kw: Any) -> None:
         if not (math.isfinite(young) and young > 0):
             raise ValueError(f"young = {young!r} is not allowed: must be > 0 Pa")

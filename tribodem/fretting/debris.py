@@ -48,6 +48,7 @@ from tribodem.dem.clumps import (
     random_quaternions,
 )
 from tribodem.dem.surfaces import HeightMapSurface, bilinear_weights
+from tribodem.materials.en24t import EN24T
 
 SHAPES = DEBRIS_SHAPES  # spherical, chunk, rubbing (seed figure 3.6; tribodem.dem.clumps)
 
@@ -60,8 +61,8 @@ class DebrisSettings:
     shares: tuple[float, float, float] = (1 / 3, 1 / 3, 1 / 3)  #: spherical, chunk, rubbing
     volume_correction: float = 1.0  #: the seed's 0.77 over-estimate correction (optional)
     density: float = 7850.0  #: kg/m^3 (EN24T)
-    young: float = 240e9  #: Pa
-    poisson: float = 0.3
+    young: float = EN24T.young  #: Pa (seed table 5.1)
+    poisson: float = EN24T.poisson
     cor: float = 0.72  #: coefficient of restitution (Marinack et al., seed 3.2.6)
     friction: float = 0.6
     rolling_friction: float = 0.001

@@ -1,26 +1,33 @@
-"""tribodem.materials: micro-parameter sets and their calibration (seed 000 section 3.1).
+"""tribodem.materials: every material once, with sources, and the calibration of seed 000.
 
-``library`` (tables 1 and 3: ``MaterialSpec``, ``Q345B``, ``CU_PM``), ``specimen``
-(bonded specimen generation), ``compression`` (uniaxial compression test, eq 12),
-``calibrate`` (automatic E_c / kratio calibration), ``cli`` (``tribodem calibrate``).
+``en24t`` (seed 003's first-body steel: tables 5.1, 6.2, section 5.2), ``library`` (seed 000
+tables 1 and 3: ``MaterialSpec``, ``Q345B``, ``CU_PM``), ``specimen`` (bonded specimen
+generation), ``compression`` (uniaxial compression test, eq 12), ``calibrate`` (automatic
+E_c / kratio calibration), ``cli`` (``tribodem calibrate``).
+
+Names are imported on first use (PEP 562), so reading a material constant does not load the
+particle engine.
 """
 
-from tribodem.materials.calibrate import CalibrationResult, calibrate
-from tribodem.materials.compression import CompressionResult, fit_moduli, run_compression
-from tribodem.materials.library import CU_PM, LIBRARY, Q345B, MaterialSpec, get_material
-from tribodem.materials.specimen import Specimen, make_specimen
+from __future__ import annotations
 
-__all__ = [
-    "CU_PM",
-    "LIBRARY",
-    "Q345B",
-    "CalibrationResult",
-    "CompressionResult",
-    "MaterialSpec",
-    "Specimen",
-    "calibrate",
-    "fit_moduli",
-    "get_material",
-    "make_specimen",
-    "run_compression",
-]
+import importlib
+from typing import Any
+
+_WHERE = {
+    "EN24T": "en24t", "SolidMaterial": "en24t",
+    "CalibrationResult": "calibrate", "calibrate": "calibrate",
+    "CompressionResult": "compression", "fit_moduli": "compression",
+    "run_compression": "compression",
+    "CU_PM": "library", "LIBRARY": "library", "Q345B": "library", "MaterialSpec": "library",
+    "get_material": "library",
+    "Specimen": "specimen", "make_specimen": "specimen",
+}
+
+__all__ = sorted(_WHERE)
+
+
+def __getattr__(name: str) -> Any:
+    if name not in _WHERE:
+        raise AttributeError(f"module 'tribodem.materials' has no attribute {name!r}")
+    return getattr(importlib.import_module(f"tribodem.materials.{_WHERE[name]}"), name)
