@@ -12,7 +12,7 @@ import pytest
 from typer.testing import CliRunner
 
 from tribodem.cyclejump import synthetic_two_phase_series
-from tribodem.cyclejump_cli import jump_app, parse_params, read_increments_csv
+from tribodem.cyclejump.cli import jump_app, parse_params, read_increments_csv
 from tribodem.io.config import ConfigError
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -44,7 +44,7 @@ COMMANDS: dict[str, tuple[str, str, bool]] = {
     "calibrate": ("tribodem.materials.cli", "calibrate", False),
     "dem": ("tribodem.dem.cli", "dem_app", True),
     "bench": ("tribodem.dem.cli", "bench_app", True),
-    "jump": ("tribodem.cyclejump_cli", "jump_app", True),
+    "jump": ("tribodem.cyclejump.cli", "jump_app", True),
     "fretting": ("tribodem.fretting.cli", "fretting_app", True),
     "braking": ("tribodem.braking.cli", "braking_app", True),
 }

@@ -17,7 +17,7 @@ from typing import Annotated, Any
 import numpy as np
 import typer
 
-from tribodem.cyclejump import STRATEGIES, ReplayResult, make_strategy, replay
+from tribodem.cyclejump.strategies import STRATEGIES, ReplayResult, make_strategy, replay
 from tribodem.io.config import ConfigError
 from tribodem.io.results import write_figure
 
