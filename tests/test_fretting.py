@@ -95,12 +95,24 @@ def test_column_search_linear_field_matches_analytic_crossing(z):
 
 
 def test_shear_criterion_wears_both_bodies_and_reports_grid():
+    from tribodem.contact import HertzSphere
+
     crit = make_criterion("shear", nz=9, samples=4)
-    h = FrettingLoop(HalfSpaceSolver(n=32), crit, n_increments=8).run(1)
+    solver = HalfSpaceSolver(n=32)
+    h = FrettingLoop(solver, crit, n_increments=8).run(1)
     # surface shear mu p0 = 0.6 x 2.76 GPa > 0.8 UTS: wear at the centre of both bodies
     assert h.wear_upper[16, 16] > 0 and h.wear_lower.max() > 0
     info = crit.info()
-    assert info["max_value_upper"] > 1.0 and info["grid_depth_m"] > 0
+    # the largest D = tau / (0.8 UTS) is the surface traction mu p_max of gross slip (eq 6.9)
+    d_max = MU * h.rows[0]["max_pressure_Pa"] / (0.8 * 1000e6)
+    assert info["max_value_upper"] == pytest.approx(d_max, rel=1e-6)
+    assert info["max_value_lower"] == pytest.approx(d_max, rel=1e-6)
+    p0 = HertzSphere(4e-3, LOAD, solver.modulus).peak_pressure
+    assert info["max_value_upper"] == pytest.approx(MU * p0 / 800e6, rel=0.02)
+    # default grid: 3 equivalent contact radii deep; the wear stays inside it
+    a = float(np.sqrt(h.rows[0]["contact_area_m2"] / np.pi))
+    assert info["grid_depth_m"] == pytest.approx(3 * a, rel=0.1)
+    assert info["saturated_columns_upper"] == 0 and h.wear_upper.max() < info["grid_depth_m"]
 
 
 def test_unavailable_criteria_refuse_with_reason():
