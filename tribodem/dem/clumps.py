@@ -43,10 +43,9 @@ from functools import cache
 import numpy as np
 from numba import njit, prange
 
-from tribodem.dem.integrate import BLOCK, local_damped
+from tribodem.dem.integrate import BLOCK, drift_of, local_damped
 from tribodem.dem.jit import kernel
 from tribodem.dem.neighbors import NeighborList, _reverse
-from tribodem.dem.space import min_image
 from tribodem.dem.state import FIX_CLUMP, FIX_ROTATION, FIX_TRANSLATION, ParticleState
 
 DEBRIS_SHAPES = ("spherical", "chunk", "rubbing")
@@ -439,12 +438,7 @@ def member_drift(pos, radius, fixed, ref_pos, ref_radius, lo, length, periodic, 
         for i in range(blk * BLOCK, min(n, (blk + 1) * BLOCK)):
             if not fixed[i] & FIX_CLUMP:
                 continue
-            dd = 0.0
-            for k in range(3):
-                dk = min_image(pos[i, k] - ref_pos[i, k], length[k], periodic[k])
-                dd += dk * dk
-            g = radius[i] - ref_radius[i]
-            dd = np.sqrt(dd) + (g if g > 0.0 else 0.0)
+            dd = drift_of(pos, ref_pos, radius, ref_radius, i, length, periodic)
             if dd > dmax:
                 dmax = dd
         drift[blk] = dmax

@@ -32,6 +32,18 @@ def local_damped(f, v, local):
 
 
 @njit(cache=True, inline="always")
+def drift_of(pos, ref_pos, radius, ref_radius, i, length, periodic):
+    """How far particle i may have come towards a neighbour since the last neighbour build,
+    m: its move (minimum image) plus its radius growth (thermal expansion)."""
+    dd = 0.0
+    for k in range(3):
+        dk = min_image(pos[i, k] - ref_pos[i, k], length[k], periodic[k])
+        dd += dk * dk
+    g = radius[i] - ref_radius[i]
+    return np.sqrt(dd) + (g if g > 0.0 else 0.0)
+
+
+@njit(cache=True, inline="always")
 def _update(pos, vel, omega, i, f, t, m, inertia, fixed, a, b, local, dt):
     """Central-difference update of particle i for force f and moment t (seed 000 eqs 4, 7)."""
     for k in range(3):
@@ -89,7 +101,6 @@ def advance(pos, vel, omega, radius, mass, inertia, fixed, start, rev_start, rev
                 force[i, k] = f[k] - mass[i] * gravity[k]
                 torque[i, k] = t[k]
             _update(pos, vel, omega, i, f, t, mass[i], inertia[i], fixed[i], a, b, local, dt)
-            dd = 0.0
             for k in range(3):
                 if periodic[k]:
                     x = pos[i, k] - lo[k]
@@ -98,10 +109,7 @@ def advance(pos, vel, omega, radius, mass, inertia, fixed, start, rev_start, rev
                         if x >= length[k]:
                             x -= length[k]
                         pos[i, k] = lo[k] + x
-                dk = min_image(pos[i, k] - ref_pos[i, k], length[k], periodic[k])
-                dd += dk * dk
-            g = radius[i] - ref_radius[i]
-            dd = np.sqrt(dd) + (g if g > 0.0 else 0.0)
+            dd = drift_of(pos, ref_pos, radius, ref_radius, i, length, periodic)
             if dd > dmax:
                 dmax = dd
         drift[blk] = dmax

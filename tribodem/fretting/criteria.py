@@ -476,6 +476,22 @@ def _shift_up(field: NDArray[np.float64], z: NDArray[np.float64],
     return out.reshape(field.shape)
 
 
+def _remove_damaged(crit: Any, info: dict[str, Any]
+                    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Wear where an accumulated damage sum (``crit._d_up``/``_d_lo`` on depths ``crit._z``:
+    DFDI, Miner's SWT sum) has reached 1, by the column search; then the sums are shifted up
+    by the worn depth (the new surface carries the damage of the material below it).
+    Sets ``crit._last_info`` = ``info`` plus the grid diagnostics; returns (upper, lower) m."""
+    du, su = column_search(crit._d_up, crit._z, 1.0)
+    dl, sl = column_search(crit._d_lo, crit._z, 1.0)
+    crit._last_info = {**info, "saturated_columns_upper": int(su.sum()),
+                       "saturated_columns_lower": int(sl.sum()),
+                       "grid_depth_m": float(crit._z[-1])}
+    crit._d_up = _shift_up(crit._d_up, crit._z, du)
+    crit._d_lo = _shift_up(crit._d_lo, crit._z, dl)
+    return du, dl
+
+
 class DFDICriterion(Criterion):
     """Ductile failure damage indicator (seed eqs 6.1-6.2), threshold DFDI >= 1.
 
@@ -551,18 +567,8 @@ class DFDICriterion(Criterion):
             # the EP solve is at offset 0: upper window frame, lower track at shift 0
             self._d_up += field
             self._d_lo[:, g.pad : g.pad + g.n, :] += field
-        du, su = column_search(self._d_up, self._z, 1.0)
-        dl, sl = column_search(self._d_lo, self._z, 1.0)
-        self._last_info = {
-            "max_dfdi_upper": float(self._d_up.max()),
-            "max_dfdi_lower": float(self._d_lo.max()),
-            "saturated_columns_upper": int(su.sum()),
-            "saturated_columns_lower": int(sl.sum()),
-            "grid_depth_m": float(self._z[-1]),
-        }
-        self._d_up = _shift_up(self._d_up, self._z, du)
-        self._d_lo = _shift_up(self._d_lo, self._z, dl)
-        return du, dl
+        return _remove_damaged(self, {"max_dfdi_upper": float(self._d_up.max()),
+                                      "max_dfdi_lower": float(self._d_lo.max())})
 
     def info(self) -> dict[str, Any]:
         return dict(self._last_info)
@@ -727,8 +733,6 @@ class SWTCriterion(ThresholdCriterion):
         self._d_up = self._d_up + r_up
         self._d_lo = self._d_lo + r_lo
         self.cycles_done += 1
-        du, su = column_search(self._d_up, self._z, 1.0)
-        dl, sl = column_search(self._d_lo, self._z, 1.0)
 
         def first_wear(d: NDArray[np.float64], r: NDArray[np.float64]) -> float:
             if np.any(d >= 1.0):
@@ -737,20 +741,14 @@ class SWTCriterion(ThresholdCriterion):
                 left = np.where(r > 0, (1.0 - d) / r, np.inf)
             return float(self.cycles_done + left.min())
 
-        self._last_info = {
+        return _remove_damaged(self, {
             "cycles_to_first_wear_upper": first_wear(self._d_up, r_up),
             "cycles_to_first_wear_lower": first_wear(self._d_lo, r_lo),
             "max_damage_rate_upper": float(r_up.max()),
             "max_damage_rate_lower": float(r_lo.max()),
             "miner_sum_max_upper": float(self._d_up.max()),
             "miner_sum_max_lower": float(self._d_lo.max()),
-            "saturated_columns_upper": int(su.sum()),
-            "saturated_columns_lower": int(sl.sum()),
-            "grid_depth_m": float(self._z[-1]),
-        }
-        self._d_up = _shift_up(self._d_up, self._z, du)
-        self._d_lo = _shift_up(self._d_lo, self._z, dl)
-        return du, dl
+        })
 
     def params(self) -> dict[str, Any]:
         return {**super().params(), "young_Pa": self.young, "poisson": self.poisson,
