@@ -6,7 +6,8 @@
 Cycle: EN24T pad R 4 mm on a flat, 100 N/mm (p0 1.02 GPa, a 62 um), mu 0.6, tangential cycle
 0 -> +3 um -> 0 -> -3 um -> 0 (gross slip at about 1.7 um) in ``--n`` increments; timed:
 meshing + deck, ccx, reading the .dat. Study: the normal load only (no tangential step), for
-each element size at the contact h / a: elements, ccx time, errors of p0 and a against Hertz.
+each element size at the contact h / a: elements, ccx time, errors of p0 and a against Hertz,
+p0 / max von Mises (Johnson: first yield at p0 = 1.79 Y).
 Prints JSON lines. Needs ``ccx`` on PATH (apt-get install calculix-ccx).
 """
 
@@ -22,7 +23,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from tribodem.contact.fe.model import LineCase, run_line_case  # noqa: E402
-from tribodem.contact.fe.validate import half_width_fit  # noqa: E402
+from tribodem.contact.fe.validate import half_width_fit, yield_checks  # noqa: E402
 
 
 def cycle(threads: int, h_over_a: float, n: int, size_factor: float) -> dict[str, object]:
@@ -49,14 +50,17 @@ def study(h_over_a: float, threads: int, size_factor: float) -> dict[str, object
     case = LineCase(load=1e5, delta=0.0, h_over_a=h_over_a, size_factor=size_factor)
     p0, a = case.hertz
     with tempfile.TemporaryDirectory(prefix="bench_fe_") as tmp:
-        run = run_line_case(case, tmp, threads=threads, timeout=1800, fine_stress=False)
+        run = run_line_case(case, tmp, threads=threads, timeout=1800, fine_stress=True)
     st = run.results.contact[run.results.at(2.0)]
     a_fit, _ = half_width_fit(st, p0)
+    vm = yield_checks(run)[0]
     return {"case": "study", "h_over_a": h_over_a, "h_um": round(h_over_a * a * 1e6, 2),
             "size_factor": size_factor, "elements": run.mesh.n_elements,
             "seconds_ccx": round(run.run.seconds, 2),
             "p0_error": round(float(st.pressure.max() / p0 - 1.0), 5),
-            "a_error": round(a_fit / a - 1.0, 5)}
+            "a_error": round(a_fit / a - 1.0, 5),
+            "yield_factor": round(vm["value"], 4),
+            "yield_factor_error": round(vm["value"] / vm["reference"] - 1.0, 4)}
 
 
 def main() -> None:

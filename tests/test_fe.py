@@ -148,7 +148,7 @@ def test_missing_ccx_names_the_install_command(tmp_path: Path,
 def coarse_run(tmp_path_factory: pytest.TempPathFactory) -> LineRun:
     if shutil.which("ccx") is None:
         pytest.skip(f"CalculiX ccx not on PATH ({INSTALL_COMMAND})")
-    return run_line_case(coarse_case(), tmp_path_factory.mktemp("fe_coarse"), threads=2,
+    return run_line_case(coarse_case(), tmp_path_factory.mktemp("fe_coarse"), threads=1,
                          timeout=300)
 
 
@@ -224,7 +224,7 @@ def test_validate_fe_all_checks_pass(tmp_path: Path) -> None:
     """The ``tribodem validate --solver fe`` checks at the default mesh (h = a / 8)."""
     from tribodem.contact.fe.validate import validate_fe
 
-    checks = validate_fe(tmp_path, threads=2, timeout=600)
+    checks = validate_fe(tmp_path, threads=1, timeout=600)
     names = [c["name"] for c in checks]
     for prefix in ("hertz_p0", "hertz_a", "first_yield_p0_over_vm", "gross_slip_Q_over_muP",
                    "mindlin_c", "Q(delta", "slip_displacement", "plastic_onset_p0_over_Y"):

@@ -3,7 +3,8 @@
 * The job runs in its folder (deck, log ``<job>.log``, ``.sta``, ``.dat``, ``.frd`` kept).
 * ``threads`` sets ``OMP_NUM_THREADS`` and ``CCX_NPROC_EQUATION_SOLVER``.
 * A run longer than ``timeout`` seconds is killed (its whole process group) and raises
-  :class:`CcxTimeoutError` (a bad contact setup can make ccx iterate for ever).
+  :class:`CcxTimeoutError` (a bad contact setup can make ccx iterate for ever); ccx is also
+  killed on Ctrl-C, and on Linux when the Python process dies (``PR_SET_PDEATHSIG``).
 * A non-zero exit code, an ``*ERROR`` line in the log, or a missing "Job finished" raises
   :class:`CcxError` (:class:`CcxConvergenceError` when ccx reports divergence or too many
   cutbacks) carrying the ccx message, the deck path and the last ``.sta`` line.
@@ -16,6 +17,7 @@ import os
 import shutil
 import signal
 import subprocess
+import sys
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -104,6 +106,17 @@ def _error_text(log: str) -> str:
     return " | ".join(out)
 
 
+def _die_with_parent() -> None:
+    """In the child before exec (Linux): SIGKILL when the Python parent dies, so a killed
+    driver does not leave ccx running in its own session."""
+    try:
+        import ctypes
+
+        ctypes.CDLL(None).prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
+    except (OSError, AttributeError):
+        pass
+
+
 def _kill(proc: subprocess.Popen[bytes]) -> None:
     """Kill ccx's process group (it runs in its own session) and reap it."""
     try:
@@ -128,7 +141,8 @@ def run_ccx(deck: str | Path, threads: int = 1, timeout: float = 600.0,
     with open(log_path, "w") as log_file:
         proc = subprocess.Popen([exe, "-i", job.name], cwd=deck.parent, env=env,
                                 stdout=log_file, stderr=subprocess.STDOUT,
-                                start_new_session=True)
+                                start_new_session=True,
+                                preexec_fn=_die_with_parent if sys.platform == "linux" else None)
         try:
             rc = proc.wait(timeout=timeout)
         except subprocess.TimeoutExpired:

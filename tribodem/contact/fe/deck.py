@@ -71,9 +71,8 @@ class ContactSettings:
     penalty_factor: float = 50.0  #: normal stiffness = factor * E_min / h_fine, Pa/m
     stick_factor: float = 0.1  #: stick slope = factor * normal stiffness, Pa/m
     formulation: str = "SURFACE TO SURFACE"  #: ccx contact pair type
-    #: friction coefficient while seating and loading (ccx converges poorly with friction in
-    #: the normal loading; for elastically similar bodies, Dundurs beta = 0, the normal
-    #: problem does not depend on friction)
+    #: friction coefficient while seating and loading (> 0: ccx rejects 0; for elastically
+    #: similar bodies, Dundurs beta = 0, the normal problem does not depend on friction)
     mu_loading: float = 1e-3
     stick_factor_loading: float = 0.1  #: stick slope factor while seating and loading
 
@@ -88,6 +87,9 @@ class LoadCase:
     half_cycle: bool = False  #: only 0 -> +delta (n_increments / 4 increments)
     load_increments: int = 5  #: increments of the loading step
     seat: float = 0.0  #: seating displacement, m (0: 5 % of a^2 / (2 R), set by the writer)
+    #: ``*CONTROLS, PARAMETERS=FIELD``: residual and correction tolerances (ccx defaults
+    #: 0.005, 0.01), e.g. (0.02, 0.05) for plastic cycles; None keeps the defaults
+    field_controls: tuple[float, float] | None = None
 
 
 def _fmt(v: float) -> str:
@@ -208,6 +210,10 @@ def write_deck(path: str | Path, mesh: Mesh, case: LoadCase,
     if case.delta > 0:
         _time_points(out, "TCYCLE", np.arange(1, n_tan + 1) * (4.0 / n))
     out.write("*BOUNDARY\nLBOT, 1, 2\n")
+    controls = ""
+    if case.field_controls is not None:
+        r_n, c_n = case.field_controls
+        controls = f"*CONTROLS, PARAMETERS=FIELD\n{r_n}, {c_n}\n"
     # step 1: seating under displacement control
     out.write("*STEP, INC=200\n*STATIC\n0.5, 1., 1e-4, 0.5\n")
     _change_friction(out, mesh, lower, upper, contact, loading=True)
@@ -218,7 +224,7 @@ def write_deck(path: str | Path, mesh: Mesh, case: LoadCase,
     dt = 1.0 / n_load
     out.write(f"*STEP, INC=1000\n*STATIC\n{dt}, 1., {dt * 1e-4}, {dt}\n")
     out.write(f"*BOUNDARY, OP=NEW\nLBOT, 1, 2\n{ref}, 1, 1, 0.\n")
-    out.write(f"*CLOAD\n{ref}, 2, {_fmt(-case.load)}\n")
+    out.write(f"*CLOAD\n{ref}, 2, {_fmt(-case.load)}\n" + controls)
     _outputs(out, plastic, fine_stress, frd, "TLOAD")
     out.write("*END STEP\n")
     # step 3: tangential displacement cycle (increments <= 4 / n, output every 4 / n)
@@ -226,7 +232,7 @@ def write_deck(path: str | Path, mesh: Mesh, case: LoadCase,
         dt = 4.0 / n
         out.write(f"*STEP, INC=10000\n*STATIC\n{dt}, {total}, {dt * 1e-4}, {dt}\n")
         _change_friction(out, mesh, lower, upper, contact, loading=False)
-        out.write(f"*BOUNDARY, AMPLITUDE=STROKE\n{ref}, 1, 1, {_fmt(case.delta)}\n")
+        out.write(f"*BOUNDARY, AMPLITUDE=STROKE\n{ref}, 1, 1, {_fmt(case.delta)}\n" + controls)
         _outputs(out, plastic, fine_stress, frd, "TCYCLE")
         out.write("*END STEP\n")
     path = Path(path)

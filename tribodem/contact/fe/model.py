@@ -37,6 +37,7 @@ class LineCase:
     upper: FEMaterial = field(default_factory=FEMaterial)
     contact: ContactSettings = field(default_factory=ContactSettings)
     load_increments: int = 5
+    field_controls: tuple[float, float] | None = None  #: see :class:`LoadCase`
 
     @property
     def e_star(self) -> float:
@@ -70,7 +71,8 @@ def build(case: LineCase, folder: str | Path, name: str = "job", fine_stress: bo
                                       stroke=case.delta, size_factor=case.size_factor,
                                       growth=case.growth))
     load = LoadCase(load=case.load, delta=case.delta, n_increments=case.n_increments,
-                    half_cycle=case.half_cycle, load_increments=case.load_increments)
+                    half_cycle=case.half_cycle, load_increments=case.load_increments,
+                    field_controls=case.field_controls)
     deck = write_deck(folder / f"{name}.inp", mesh, load, case.lower, case.upper, case.contact,
                       fine_stress=fine_stress, frd=frd)
     return mesh, deck
