@@ -15,11 +15,18 @@ Model (SI units; per unit length: the plane-strain thickness is 1 m, so forces a
   reference node REF (x = 0) by ``*EQUATION`` in x and y (no rocking), so the normal load is
   one ``*CLOAD`` and the tangential displacement one ``*BOUNDARY`` on REF;
 * steps: (1) seating: REF moved down by ``seat`` (m) under displacement control, x held;
-  (2) loading: the y displacement released, P (N/m) applied on REF as a ramp, x held;
+  (2) loading: the y displacement released, P (N/m) applied on REF as a ramp, x held,
+  automatic increments <= P / ``load_increments``;
   (3) tangential: REF x displacement 0 -> +delta -> 0 -> -delta -> 0 (``*AMPLITUDE`` over a
-  step time of 4), ``n_increments`` fixed increments (``*STATIC, DIRECT``).
+  step time of 4), automatic increments <= 4 / ``n_increments``; friction is mu_loading
+  (0.001) in steps 1-2 and mu in step 3 (``*CHANGE FRICTION``). (Fixed ``DIRECT``
+  increments diverged in the loading, and ccx refuses them together with ``*TIME POINTS``.)
 
-Output to the ``.dat`` file every increment: total reaction force of the flat's bottom
+The small-strain (``NLGEOM`` off) solution treats the table 5.1 strengths as true stresses.
+
+Output to the ``.dat`` file at the ``*TIME POINTS`` (every P / ``load_increments`` and every
+4 / ``n_increments`` of the cycle, i.e. at :func:`tribodem.contact.cycle_offsets`) and at the
+end of each seating increment: total reaction force of the flat's bottom
 (``*NODE PRINT, TOTALS=ONLY``), displacements of REF and of both contact faces, the
 integration-point stresses of the elements along both contact faces (the contact tractions
 are recovered from them, see :mod:`tribodem.contact.fe.results`) and optionally of the fine
