@@ -293,3 +293,58 @@ def test_quick_preset_overrides_the_config_file(tmp_path: Path) -> None:
     assert q.run.duration_s == QUICK["run"]["duration_s"]
     assert q.run.samples == QUICK["run"]["samples"] and q.condition.index == 4
     assert _config(None, None, quick=True).run.samples == QUICK["run"]["samples"]
+
+
+def test_steady_state_rule() -> None:
+    from tribodem.braking.run import steady_state
+
+    s = np.linspace(0.0, 3e-4, 31)
+    h = np.where(s < 1e-4, 0.2 * s, 2e-5 + 0.05 * (s - 1e-4))  # fast run-in, then steady
+    st = steady_state(s, h)
+    assert st["steady"] and st["rate"] == pytest.approx(0.05)
+    assert st["run_in_distance"] == pytest.approx(1e-4) and st["run_in_depth"] == \
+        pytest.approx(2e-5)
+    h2 = np.where(s < 2e-4, 0.05 * s, 1e-5 + 0.1 * (s - 2e-4))  # last third twice as fast
+    assert not steady_state(s, h2)["steady"]
+    assert not steady_state(s, np.zeros_like(s))["steady"]  # no wear: no steady rate
+
+
+def test_until_steady_with_a_load_ramp_resumes_bitwise(tmp_path: Path,
+                                                       monkeypatch: pytest.MonkeyPatch
+                                                       ) -> None:
+    """A run that slides past its duration (never steady at a 1e-9 tolerance, so up to its
+    distance cap) under a load ramp, interrupted inside the ramp after its first extension
+    and resumed: bitwise the uninterrupted run; the summary reports the steady-state and
+    contact fields."""
+    import tribodem.braking.run as run_mod
+    from tribodem.braking.run import read_checkpoint
+
+    change = {"duration_s": 0.5e-6, "samples": 10, "vtk_snapshots": 0, "until_steady": True,
+              "steady_tolerance": 1e-9, "max_distance_m": 47.12 * 0.8e-6, "ramp_s": 0.75e-6}
+    full = run_braking(_tiny(change), tmp_path / "a")
+    assert full["simulated_sliding_distance_m"] == pytest.approx(47.12 * 0.8e-6, rel=0.02)
+    assert full["steady_reached"] is False and 0 <= full["contact_fraction"] <= 1
+    for k in ("wear_rate_steady_m_per_m", "run_in_distance_m", "run_in_depth_m",
+              "interface_load_ratio_mean", "sliding_distance_cap_m"):
+        assert k in full
+    real = run_mod.measure
+    calls = [0]
+
+    def interrupted(*a: object, **k: object) -> dict:
+        calls[0] += 1
+        if calls[0] == 14:
+            raise KeyboardInterrupt
+        return real(*a, **k)
+
+    monkeypatch.setattr(run_mod, "measure", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        run_braking(_tiny(change), tmp_path / "b")
+    monkeypatch.setattr(run_mod, "measure", real)
+    rec = read_checkpoint(tmp_path / "b" / "checkpoint.npz")
+    assert rec["min_steps"] < rec["done"] < rec["cap_steps"] and not rec["finished"]
+    res = run_braking(_tiny(change), tmp_path / "b", resume=True)
+    for k, v in full.items():
+        if not k.startswith("wall_time"):
+            assert repr(res[k]) == repr(v), k
+    assert (tmp_path / "a" / "timeseries.csv").read_bytes() == \
+        (tmp_path / "b" / "timeseries.csv").read_bytes()

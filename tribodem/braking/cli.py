@@ -90,6 +90,17 @@ class RunCfg(_Strict):
     dt_safety: float = Field(0.3, gt=0, le=1)
     threads: int = Field(0, ge=0, le=256, description="0 = all cores")
     figures: bool = True
+    until_steady: bool = Field(
+        False, description="slide past duration_s until the wear rate per sliding distance "
+                           "is steady (last third within steady_tolerance of the middle "
+                           "third), in blocks of 20% of duration_s, at most max_distance_m")
+    max_distance_m: float = Field(0.0, ge=0, le=1.0,
+                                  description="cap on the sliding distance (m) with "
+                                              "until_steady; 0 = 5 x speed x duration_s")
+    steady_tolerance: float = Field(0.15, gt=0, le=1)
+    ramp_s: float = Field(0.0, ge=0, le=1e-2,
+                          description="load ramped linearly from 0 over this sliding time "
+                                      "(s); 0 = the full load at once")
     checkpoint_every: int = Field(
         0, ge=0, le=100_000,
         description="samples between checkpoints (checkpoint.npz in the output folder); "
@@ -170,7 +181,9 @@ def setup_from_config(cfg: BrakingConfig) -> Any:
                     plate_areal_mass=r.plate_areal_mass_kg_m2 or None, backing=r.backing,
                     local_damping=r.local_damping, dt_safety=r.dt_safety,
                     thermal_curve=curve, thermal_time_map=cfg.thermal.time_map,
-                    figures=r.figures, checkpoint_every=r.checkpoint_every)
+                    figures=r.figures, checkpoint_every=r.checkpoint_every,
+                    until_steady=r.until_steady, max_distance_m=r.max_distance_m,
+                    steady_tolerance=r.steady_tolerance, ramp_s=r.ramp_s)
 
 
 #: config fields a resumed run may change (they do not change the results)
@@ -179,7 +192,9 @@ RESUME_FREE = ("run.threads", "run.checkpoint_every", "run.figures")
 _SHOWN = ("status", "condition", "pressure_Pa", "sliding_speed_m_s", "simulated_time_s",
           "simulated_sliding_distance_m", "wear_depth_mean_m", "wear_depth_max_m",
           "broken_bonds", "debris_particles", "force_chains", "particles_initial",
-          "particles_final", "mean_wall_pressure_ratio", "wall_time_s")
+          "particles_final", "mean_wall_pressure_ratio", "wear_rate_steady_m_per_m",
+          "steady_reached", "run_in_distance_m", "run_in_depth_m", "contact_fraction",
+          "wall_time_s")
 
 
 def _config(condition: int | None, config: Path | None, quick: bool,

@@ -105,6 +105,15 @@ def trend_verdict(steps: list[tuple[float, float]], total: tuple[float, float],
             "not reproduced: the total change has the opposite sign (within the scatter)")
 
 
+def steady_rate(r: dict[str, Any]) -> float:
+    """A run's steady wear rate per sliding distance (m/m): ``wear_rate_steady_m_per_m``
+    (after the run-in, issue 15), or for runs made before it the second-half rate in time
+    divided by the speed."""
+    if "wear_rate_steady_m_per_m" in r:
+        return float(r["wear_rate_steady_m_per_m"])
+    return float(r["steady_wear_rate_m_s"]) / float(r["sliding_speed_m_s"])
+
+
 def _mean_summary(runs: list[dict[str, Any]]) -> dict[str, Any]:
     """Mean over seeds of every numeric summary entry (the first run's other entries)."""
     out = dict(runs[0])
@@ -160,8 +169,9 @@ def write_comparison(out: Path, runs: dict[int, list[tuple[dict[str, Any], Path]
     series = {k: _series(v[0][1]) for k, v in runs.items()}  # condition 5 history: seed 0
     per_seed = {
         "wear": {k: np.array([r["wear_depth_mean_m"] for r, _ in v]) for k, v in runs.items()},
-        "rate": {k: np.array([r["steady_wear_rate_m_s"] for r, _ in v])
-                 for k, v in runs.items()},
+        "rate": {k: np.array([steady_rate(r) for r, _ in v]) for k, v in runs.items()},
+        "contact": {k: np.array([r.get("contact_fraction", np.nan) for r, _ in v])
+                    for k, v in runs.items()},
         "chains": {k: np.array([_late_mean(_series(d), "force_chains") for _, d in v])
                    for k, v in runs.items()},
         "strong": {k: np.array([_late_mean(_series(d), "strong_force_chains") for _, d in v])
@@ -175,12 +185,13 @@ def write_comparison(out: Path, runs: dict[int, list[tuple[dict[str, Any], Path]
     rate = {k: float(x.mean()) for k, x in per_seed["rate"].items()}
     rate_sd = {k: float(x.std(ddof=1)) if x.size > 1 else float("nan")
                for k, x in per_seed["rate"].items()}
+    contact = {k: float(x.mean()) for k, x in per_seed["contact"].items()}
     chains = {k: float(x.mean()) for k, x in per_seed["chains"].items()}
     strong = {k: float(x.mean()) for k, x in per_seed["strong"].items()}
     ch: dict[str, dict[tuple[int, int], tuple[float, float]]] = {
         q: {(a, b): change_with_error(per_seed[q][a], per_seed[q][b])
             if a in runs and b in runs else nan
-            for _, a, b, _, _ in SEED_CHANGES} for q in per_seed}
+            for _, a, b, _, _ in SEED_CHANGES} for q in per_seed if q != "contact"}
     rows_csv = []
     lines = []
     printed = []
@@ -218,8 +229,8 @@ def write_comparison(out: Path, runs: dict[int, list[tuple[dict[str, Any], Path]
     write_csv(out / "comparison.csv",
               ["change", "from_condition", "to_condition", "seeds", "wear_depth_from_m",
                "wear_depth_to_m", "wear_depth_change_pct", "wear_depth_change_se_pct",
-               "wear_depth_verdict", "seed_wear_depth_change_pct", "wear_rate_from_m_s",
-               "wear_rate_to_m_s", "wear_rate_change_pct", "wear_rate_change_se_pct",
+               "wear_depth_verdict", "seed_wear_depth_change_pct", "wear_rate_from_m_per_m",
+               "wear_rate_to_m_per_m", "wear_rate_change_pct", "wear_rate_change_se_pct",
                "wear_rate_verdict", "force_chains_from", "force_chains_to",
                "force_chains_change_pct", "force_chains_change_se_pct",
                "seed_force_chains_change_pct", "strong_force_chains_change_pct",
@@ -238,8 +249,8 @@ def write_comparison(out: Path, runs: dict[int, list[tuple[dict[str, Any], Path]
          trend("wear", (1, 2, 5), "up")),
         ("wear depth rises with speed (800 -> 1000 -> 1200 r/min; seed +16.22%)",
          trend("wear", (3, 4, 5), "up")),
-        ("steady wear rate (2nd half) rises with load", trend("rate", (1, 2, 5), "up")),
-        ("steady wear rate (2nd half) rises with speed", trend("rate", (3, 4, 5), "up")),
+        ("steady wear rate per distance rises with load", trend("rate", (1, 2, 5), "up")),
+        ("steady wear rate per distance rises with speed", trend("rate", (3, 4, 5), "up")),
         ("force chains fall with load (seed -23.37%, -5.96%)",
          trend("chains", (1, 2, 5), "down")),
         ("force chains fall with speed (seed -15.58%, -3.86%)",
@@ -263,7 +274,8 @@ def write_comparison(out: Path, runs: dict[int, list[tuple[dict[str, Any], Path]
                    f"{r['sliding_speed_m_s']:.4g} | {r['simulated_time_s'] * 1e6:.3g} | "
                    f"{r['simulated_sliding_distance_m'] * 1e6:.4g} | "
                    f"{wear[k] * 1e6:.2f} +- {spread[k] * 1e6:.2f} | "
-                   f"{rate[k]:.3g} +- {rate_sd[k]:.2g} | "
+                   f"{rate[k] * 1e3:.3g} +- {rate_sd[k] * 1e3:.2g} | "
+                   f"{contact[k]:.3f} | "
                    f"{r['wear_depth_max_m'] * 1e6:.1f} | "
                    f"{r['wear_depth_mean_disc_m'] * 1e6:.2f} | {r['broken_bonds']:.0f} "
                    f"({r['broken_bonds_tensile']:.0f}/{r['broken_bonds_shear']:.0f}) | "
@@ -275,6 +287,8 @@ def write_comparison(out: Path, runs: dict[int, list[tuple[dict[str, Any], Path]
         f"{k}: " + ", ".join(f"{x * 1e6:.1f}" for x in per_seed["wear"][k])
         for k in sorted(per_seed["wear"]))
     rel = [spread[k] / wear[k] for k in wear if wear[k] > 0 and np.isfinite(spread[k])]
+    rel_rate = {k: rate_sd[k] / rate[k] for k in rate
+                if rate[k] > 0 and np.isfinite(rate_sd[k])}
     scatter = (f"Seed-to-seed scatter of the pad wear depth: sd/mean = "
                f"{100 * min(rel):.1f}-{100 * max(rel):.1f}% over {n_seeds} seeds. A change "
                f"is called up/down only when it exceeds {_factor(n_seeds):.2f} standard "
@@ -284,6 +298,9 @@ def write_comparison(out: Path, runs: dict[int, list[tuple[dict[str, Any], Path]
                "error is that of the mean per-seed difference." if rel else
                "One packing per condition: the scatter between packings is not measured "
                "here (use --packings N), so no change can be called resolved.")
+    if rel_rate:
+        scatter += (" Scatter of the steady wear rate between packings (sd/mean): " + ", ".join(
+            f"condition {k} {100 * v:.0f}%" for k, v in sorted(rel_rate.items())) + ".")
     extrap = (
         f"Our linear extrapolation to 8 s (steady rate over the second half, clipped at "
         f"0): {r5['wear_depth_mean_extrapolated_8s_m'] * 1e3:.3g} mm "
@@ -301,17 +318,20 @@ def write_comparison(out: Path, runs: dict[int, list[tuple[dict[str, Any], Path]
         f"seeds. Every run simulates {t_sim * 1e6:.3g} us of sliding (the same braking time "
         "for all conditions, as the seed compares at 8 s); the seed's 8 s are not "
         f"simulated (fraction {t_sim / SEED_BRAKING_TIME_S:.2e}). Wear depth = mean pad "
-        "wear depth at the end (worn solid area / (packing fraction x width)); wear rate = "
-        "least-squares slope of the pad wear depth over the second half of the run (after "
-        "the run-in); force chains = time mean over the second half of the run.",
+        "wear depth at the end (worn solid area / (packing fraction x width)); steady wear "
+        "rate = wear depth per sliding distance after the run-in (summary.json "
+        "`wear_rate_steady_m_per_m`: slope over the last two thirds of the distance); "
+        "contact fraction = share of the time the interface carries load; force chains = "
+        "time mean over the second half of the run.",
         "",
         "## Per condition",
         "",
         "| cond. | load kN | p MPa | r/min | v m/s | t_sim us | slid um | pad wear mean um "
-        "(+- sd) | wear rate 2nd half m/s (+- sd) | pad wear max um | disc wear mean um | "
+        "(+- sd) | steady wear rate um/mm (+- sd) | contact fraction | pad wear max um | "
+        "disc wear mean um | "
         "broken bonds (tens./shear) | debris | chains | strong chains | mean plate force / "
         "target | particles end/start | wall s |",
-        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
         *per,
         "",
         f"Pad wear depth per seed (um), condition: values -- {seeds_txt}.",
@@ -362,6 +382,13 @@ def write_comparison(out: Path, runs: dict[int, list[tuple[dict[str, Any], Path]
                 "per-packing changes (t(0.975, n-1) x se); reproduced = |seed_pct - ours_pct| "
                 "<= ci95_pct (null with one packing); resolved = |ours_pct| > ci95_pct",
         "trends": trends_json,
+        "per_condition": {str(k): {
+            "packings": int(per_seed["wear"][k].size),
+            "wear_depth_mean_m": _num(wear[k]), "wear_depth_sd_m": _num(spread[k]),
+            "wear_rate_steady_m_per_m": _num(rate[k]),
+            "wear_rate_steady_sd_m_per_m": _num(rate_sd[k]),
+            "wear_rate_steady_scatter": _num(rel_rate.get(k, float("nan"))),
+            "contact_fraction": _num(contact[k])} for k in sorted(results)},
         "verdicts": {w: v for w, v in verdicts},
         "failed": dict(failed or {}),
         "wall_time_s": wall_s,

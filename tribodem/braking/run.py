@@ -8,6 +8,13 @@ braking (377 m at 47 m/s) is out of reach; the summary reports the fraction simu
 separately labelled, a linear extrapolation of the mean wear depth to 8 s from the steady
 wear rate (least-squares slope over the second half of the run).
 
+Steady state (issue 15): ``until_steady`` slides past ``duration_s`` in blocks of 20% of
+it until ``steady_state`` holds on the wear depth against the sliding distance (the
+last-third rate within ``steady_tolerance`` of the middle-third rate), at most
+``max_distance_m``; every summary reports ``wear_rate_steady_m_per_m``, the run-in distance
+and depth, and ``contact_fraction`` (share of looks, one every ``CONTACT_EVERY`` steps, at
+which a disc-pad contact carries load). ``ramp_s`` ramps the load on from 0.
+
 Checkpoints and resuming (``run_braking(..., resume=True)``, ``tribodem braking run
 --resume``): one file, ``<out>/checkpoint.npz``, written atomically by the engine's
 ``Simulation.save_checkpoint`` after the first sample, every ``checkpoint_every`` samples
@@ -63,7 +70,7 @@ HEAT_CAPACITY = {DISC: 460.0, PAD: 400.0}
 
 #: the run's checkpoint in its output folder (see the module docstring)
 CHECKPOINT = "checkpoint.npz"
-LOOP_VERSION = 1
+LOOP_VERSION = 2
 LOOP_KEY = "braking_loop"
 #: ``RunSetup`` fields a resumed run may change: they do not change the results
 RESUME_FREE = ("checkpoint_every", "figures")
@@ -90,6 +97,14 @@ class RunSetup:
     thermal_time_map: str = "simulated"
     figures: bool = True
     checkpoint_every: int = 0  # samples between checkpoints; 0: ceil(samples / 10)
+    #: slide past ``duration_s`` until the wear rate per sliding distance is steady
+    #: (``steady_state``), in blocks of 20% of ``duration_s``, at most ``max_distance_m``
+    until_steady: bool = False
+    max_distance_m: float = 0.0  # 0: 5 x the distance of duration_s
+    steady_tolerance: float = 0.15
+    #: applying the load: the full target at once (``0``) or ramped linearly from 0 over
+    #: ``ramp_s`` seconds of sliding (the pad applied as a hydraulic pressure builds up)
+    ramp_s: float = 0.0
 
 
 class _Loop:
@@ -98,16 +113,36 @@ class _Loop:
     state (``record``: JSON-able, ``arrays``: numpy) into the engine checkpoint through
     ``state``/``set_state``, so one atomic file holds everything a resumed run needs."""
 
-    def __init__(self, iface: Interface) -> None:
+    def __init__(self, iface: Interface, ramp_steps: int = 0) -> None:
         self.iface = iface
         self.total = 0.0
         self.n = 0
         self.record: dict[str, Any] = {}
         self.arrays: dict[str, np.ndarray] = {}
+        self.ramp_steps = ramp_steps
+        self.full = iface.target_force
+        # contact accounting every CONTACT_EVERY steps: looks, looks with load through the
+        # interface, sum of the interface load / target
+        self.contact = np.zeros(3)
+        self.apply()
+
+    def apply(self) -> None:
+        """The plate's target after ``n`` steps: ramped linearly over ``ramp_steps``."""
+        f = self.full * min(1.0, (self.n + 1) / self.ramp_steps) if self.ramp_steps \
+            else self.full
+        if self.iface.backing is not None:
+            self.iface.backing.target = f
+        else:
+            self.iface.wall.target_force = f
 
     def compute(self, sim: Any) -> None:
         self.total += plate_force(self.iface)
+        if self.n % CONTACT_EVERY == 0:
+            load = interface_load(self.iface)
+            self.contact += (1.0, float(load > 0.0), load / self.full)
         self.n += 1
+        if self.ramp_steps and self.n <= self.ramp_steps:
+            self.apply()
 
     @property
     def mean(self) -> float:
@@ -117,6 +152,7 @@ class _Loop:
         """The wall-mean accumulator, the loop record (JSON) and the loop's arrays."""
         out = {f"a_{k}": v for k, v in self.arrays.items()}
         out["wall"] = np.array([self.total, float(self.n)])
+        out["contact"] = self.contact.copy()
         out[LOOP_KEY] = np.array(json.dumps(self.record))
         return out
 
@@ -124,8 +160,48 @@ class _Loop:
         """Restore what ``state`` returned."""
         self.total, n = (float(x) for x in s["wall"])
         self.n = int(n)
+        self.contact = np.array(s["contact"], dtype=np.float64)
+        self.apply()
         self.record = json.loads(str(s[LOOP_KEY]))
         self.arrays = {k[2:]: np.array(v) for k, v in s.items() if k.startswith("a_")}
+
+
+#: steps between two looks at the disc-pad contacts (``contact_fraction``)
+CONTACT_EVERY = 16
+
+
+def interface_load(iface: Interface) -> float:
+    """Load (N) carried through the interface now: the summed normal force of the active
+    contacts between a disc particle and a pad particle (matrix or debris)."""
+    c = iface.sim.contacts()
+    g = iface.sim.p.group
+    f = c["normal_force"]
+    cross = (g[c["i"]] != g[c["j"]]) & (f > 0)
+    return float(f[cross].sum())
+
+
+def _slope(x: np.ndarray, y: np.ndarray) -> float:
+    return float(np.polyfit(x, y, 1)[0]) if x.size >= 2 and np.ptp(x) > 0 else float("nan")
+
+
+def steady_state(s: np.ndarray, h: np.ndarray, tol: float = 0.15) -> dict[str, Any]:
+    """The steady-state test on the wear depth ``h`` (m) against the sliding distance
+    ``s`` (m): least-squares rates over the middle and the last third of the distance;
+    steady when the middle-third rate is positive and the last-third rate lies within
+    ``tol`` of it. The steady rate (m of wear per m slid) is the slope over the last two
+    thirds; the run-in is the first third (its distance, and the depth at its end)."""
+    s, h = np.asarray(s, dtype=float), np.asarray(h, dtype=float)
+    nan = float("nan")
+    if s.size < 6 or not s[-1] > 0:
+        return {"steady": False, "rate": nan, "rate_mid": nan, "rate_last": nan,
+                "run_in_distance": nan, "run_in_depth": nan}
+    a, b = s[-1] / 3.0, 2.0 * s[-1] / 3.0
+    mid, last, after = (s >= a) & (s <= b), s >= b, s >= a
+    r_mid, r_last = _slope(s[mid], h[mid]), _slope(s[last], h[last])
+    ok = bool(r_mid > 0 and abs(r_last - r_mid) <= tol * r_mid)
+    return {"steady": ok, "rate": _slope(s[after], h[after]), "rate_mid": r_mid,
+            "rate_last": r_last, "run_in_distance": a,
+            "run_in_depth": float(np.interp(a, s, h))}
 
 
 def differences(old: dict[str, Any], new: dict[str, Any], prefix: str = ""
@@ -293,10 +369,15 @@ def run_braking(setup: RunSetup, out: Path | None = None, *, resume: bool = Fals
         _thermal(iface, setup, t0)
     start_sliding(iface, setup.speed_m_s)
     ref = reference(iface)
-    loop = _Loop(iface)
+    loop = _Loop(iface, int(math.ceil(setup.ramp_s / sim.dt)) if setup.ramp_s > 0 else 0)
     sim.add_interaction(loop)
     wall_y0 = float(iface.wall.point[1])
-    total_steps = max(1, int(math.ceil(setup.duration_s / sim.dt)))
+    min_steps = max(1, int(math.ceil(setup.duration_s / sim.dt)))
+    total_steps = min_steps
+    cap_steps = max(min_steps, int(math.ceil(max_distance(setup) / (setup.speed_m_s * sim.dt)))
+                    ) if setup.until_steady else min_steps
+    block = max(1, int(math.ceil(0.2 * min_steps)))
+    ended = False
     every = max(1, total_steps // max(1, setup.samples))
     ck_every = checkpoint_interval(setup)
     vtk_at = set(np.linspace(0, total_steps, max(setup.vtk_snapshots, 0)).astype(int).tolist()
@@ -318,7 +399,8 @@ def run_braking(setup: RunSetup, out: Path | None = None, *, resume: bool = Fals
                "wall_force_N": plate_force(iface),
                "wall_pressure_Pa": plate_force(iface) / (iface.width * iface.disc.thickness),
                "wall_displacement_m": float(iface.wall.point[1]) - wall_y0,
-               "kinetic_energy_J": sim.kinetic_energy()}
+               "kinetic_energy_J": sim.kinetic_energy(),
+               "interface_force_N": interface_load(iface)}
         row.update(measure(iface, ref, slid))
         rows.append({k: float(v) for k, v in row.items()})
         if out is not None and any(done >= s and s not in seen for s in vtk_at):
@@ -344,11 +426,12 @@ def run_braking(setup: RunSetup, out: Path | None = None, *, resume: bool = Fals
         loop.record = {
             "version": LOOP_VERSION, "setup": setup_record(setup), "config": config,
             "done": done,
-            "total_steps": total_steps, "every": every, "n0": n0, "t0": t0,
+            "total_steps": total_steps, "min_steps": min_steps, "cap_steps": cap_steps,
+            "every": every, "n0": n0, "t0": t0,
             "wall_y0": wall_y0, "k_vtk": k_vtk, "seen": sorted(seen),
             "entries": entries, "chain_entries": chain_entries, "columns": cols,
             "frames": {k: sorted(v) for k, v in frames.items()},
-            "finished": done >= total_steps,
+            "finished": ended,
             "wall_time_build_s": wall_before["build"],
             "wall_time_sliding_s": wall_before["sliding"] + time.perf_counter() - t_slide,
             "wall_time_s": wall_before["total"] + time.perf_counter() - t_wall,
@@ -370,13 +453,15 @@ def run_braking(setup: RunSetup, out: Path | None = None, *, resume: bool = Fals
             raise ConfigError(f"checkpoint '{ck}' cannot be used: {err}") from None
         r = loop.record
         a = loop.arrays
-        if (r["total_steps"], r["every"], r["n0"]) != (total_steps, every, n0) or not (
+        if (r["min_steps"], r["cap_steps"], r["every"], r["n0"]) != (
+                min_steps, cap_steps, every, n0) or not (
                 np.array_equal(a["ref_pos"], ref.pos)
                 and np.array_equal(a["ref_radius"], ref.radius)):
             raise ConfigError(f"checkpoint '{ck}' cannot be used: the interface rebuilt from "
                               "the same setup differs from the checkpointed one (packing not "
                               "reproduced on this machine); allowed: resume where it was made")
         done, k_vtk, seen = int(r["done"]), int(r["k_vtk"]), set(r["seen"])
+        total_steps, ended = int(r["total_steps"]), bool(r["finished"])
         entries[:] = [(float(t), str(f)) for t, f in r["entries"]]
         chain_entries[:] = [(float(t), str(f)) for t, f in r["chain_entries"]]
         rows[:] = [dict(zip(r["columns"], (float(x) for x in row), strict=True))
@@ -398,12 +483,20 @@ def run_braking(setup: RunSetup, out: Path | None = None, *, resume: bool = Fals
         if out is not None:
             save_checkpoint()
             write_rows()
-    resumed_at = done
+    resumed_finished = ended
     t_slide = time.perf_counter()
     try:
         with runs.progress(total_steps, "step", "braking run", enabled=progress,
                            initial=done) as bar:
-            while done < total_steps:
+            while True:
+                if done >= total_steps:
+                    if (not setup.until_steady or done >= cap_steps or steady_state(
+                            *_wear_vs_distance(rows), setup.steady_tolerance)["steady"]):
+                        ended = True
+                        break
+                    total_steps = min(cap_steps, total_steps + block)  # slide further
+                    bar.total = total_steps
+                    getattr(bar, "refresh", lambda: None)()
                 k = min(every, total_steps - done)
                 sim.step(k)
                 done += k
@@ -434,7 +527,7 @@ def run_braking(setup: RunSetup, out: Path | None = None, *, resume: bool = Fals
         raise
     if "end" not in frames:
         frames["end"] = _frame(iface, ref, setup.speed_m_s * (sim.time - t0))
-    if out is not None and (saved is None or resumed_at < total_steps):
+    if out is not None and not resumed_finished:
         save_checkpoint()  # the finished state: a later --resume only reports it
     slide_wall = wall_before["sliding"] + time.perf_counter() - t_slide
     last = rows[-1]
@@ -448,6 +541,8 @@ def run_braking(setup: RunSetup, out: Path | None = None, *, resume: bool = Fals
     tt = np.array([r["time_s"] for r in rows])
     hh = np.array([r["wear_depth_mean_m"] for r in rows])
     rate, h8 = wear_extrapolation(tt, hh, SEED_BRAKING_TIME_S)
+    st = steady_state(*_wear_vs_distance(rows), setup.steady_tolerance)
+    looks = max(loop.contact[0], 1.0)
     summary: dict[str, Any] = {
         "status": "finished",
         "condition": setup.condition,
@@ -473,6 +568,24 @@ def run_braking(setup: RunSetup, out: Path | None = None, *, resume: bool = Fals
             "compressive_force_chains", "transfer_layer_thickness_m", "wear_range_disc_m",
             "wear_range_pad_m", "wear_range_ratio", "debris_max_vertical_displacement_m")},
         "steady_wear_rate_m_s": rate,
+        "wear_rate_steady_m_per_m": st["rate"],
+        "wear_rate_middle_third_m_per_m": st["rate_mid"],
+        "wear_rate_last_third_m_per_m": st["rate_last"],
+        "steady_reached": st["steady"],
+        "steady_rule": f"least-squares wear-depth rate per sliding distance over the last "
+                       f"third within +-{100 * setup.steady_tolerance:g}% of the middle "
+                       "third's (positive); steady rate = slope over the last two thirds; "
+                       "run-in = the first third",
+        "run_in_distance_m": st["run_in_distance"],
+        "run_in_depth_m": st["run_in_depth"],
+        "sliding_distance_cap_m": cap_steps * sim.dt * setup.speed_m_s,
+        "contact_fraction": loop.contact[1] / looks,
+        "contact_fraction_definition": f"fraction of steps (one look every {CONTACT_EVERY}) "
+                                       "at which disc and pad particles (matrix or debris) "
+                                       "are in contact with a positive normal force, i.e. "
+                                       "the interface carries load",
+        "interface_load_ratio_mean": loop.contact[2] / looks,
+        "ramp_s": setup.ramp_s,
         "wear_depth_mean_extrapolated_8s_m": h8,
         "particles_initial": n0,
         "particles_final": int(inside.sum()),
@@ -512,6 +625,16 @@ def run_braking(setup: RunSetup, out: Path | None = None, *, resume: bool = Fals
 
             plot_run(out, rows, frames, iface, summary)
     return summary
+
+
+def max_distance(setup: RunSetup) -> float:
+    """The cap on the sliding distance (m) of a run that slides until steady."""
+    return setup.max_distance_m or 5.0 * setup.speed_m_s * setup.duration_s
+
+
+def _wear_vs_distance(rows: list[dict[str, float]]) -> tuple[np.ndarray, np.ndarray]:
+    return (np.array([r["sliding_distance_m"] for r in rows]),
+            np.array([r["wear_depth_mean_m"] for r in rows]))
 
 
 def _frame(iface: Interface, ref: Reference, slid: float) -> dict[str, np.ndarray]:
