@@ -22,6 +22,13 @@ Model (seed 003 sections 3.3 and 6.1, replacing the Abaqus FE phase):
   f mu kappa gap*(x) in partial slip, offset change - f mu kappa (d - g(x)) in gross slip,
   so the dissipated energy includes the elastic tangential compliance exactly (within the
   approximation) whatever the increment size. Gross slip reached after 2 mu kappa d.
+* Line contact (``contact="line"``, e.g. a cylinder with its axis along y on a flat): when
+  the summed recession does not depend on y, the periodic window is an infinitely long
+  contact along y (plane strain) and tamaas's periodic BEM solves it as it is; ``load`` is
+  the total load on the window, i.e. P' = load / window per unit length. Only the x edges
+  are checked for the contact (it touches both y edges by design). The rigid approach of a
+  line contact is undefined on a half-space (logarithmic), so the Ciavarella-Jaeger regime
+  (built on the point-contact approach) and the debris pressure are refused for it.
 * Subsurface stress under each body: tamaas ``volume_2d`` model with the Boussinesq-Cerruti
   gradient and Hooke operators applied to that body's surface traction (normal + shear).
 """
@@ -29,7 +36,7 @@ Model (seed 003 sections 3.3 and 6.1, replacing the Abaqus FE phase):
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 import tamaas as tm
@@ -49,7 +56,7 @@ from tribodem.contact.base import (
     contact_modulus,
     dundurs_beta,
 )
-from tribodem.contact.geometry import HertzSphere, Recession, crossed_cylinders
+from tribodem.contact.geometry import HertzSphere, Recession, crossed_cylinders, line_window
 
 tm.set_log_level(tm.LogLevel.error)
 
@@ -78,10 +85,8 @@ def set_model_fields(model: tm.Model, fields: dict[str, NDArray[np.float64]]) ->
         dst[...] = v
 
 
-def _estimate_contact_radius(
-    upper: Recession, lower: Recession, load: float, modulus: float
-) -> float:
-    """Hertz contact radius from the curvatures of the summed recession at the origin, m."""
+def _curvatures(upper: Recession, lower: Recession) -> tuple[float, float]:
+    """Curvatures (kx, ky) (1/m) of the summed recession at the origin (10 um differences)."""
     h = 1e-5
     z = np.zeros(1)
 
@@ -91,6 +96,14 @@ def _estimate_contact_radius(
 
     kx = (g(h, 0) + g(-h, 0) - 2 * g(0, 0)) / h**2
     ky = (g(0, h) + g(0, -h) - 2 * g(0, 0)) / h**2
+    return kx, ky
+
+
+def _estimate_contact_radius(
+    upper: Recession, lower: Recession, load: float, modulus: float
+) -> float:
+    """Hertz contact radius from the curvatures of the summed recession at the origin, m."""
+    kx, ky = _curvatures(upper, lower)
     if not (kx > 0 and ky > 0):
         raise ValueError(
             "window is None but the summed recession has no positive curvature at the origin "
@@ -111,10 +124,16 @@ class HalfSpaceSolver(FirstBodySolver):
     Hertz radii estimated from the summed recession's curvature at the origin (10 um
     finite differences: give ``window`` explicitly for coarse height maps). ``regime`` is
     ``"gross"`` (q = mu p) or ``"ciavarella-jaeger"`` (partial slip after reversals).
+
+    ``contact``: ``"point"``, ``"line"`` or None (found: a line contact when the summed
+    recession on the window does not depend on y). For a line contact ``load`` is the total
+    load on the window (P' = load / window, N/m), the default window holds ``window_radii``
+    Hertz half-widths (W^3 = k^2 4 P R / (pi E*)), only the x edges are checked, and
+    ``regime`` must be ``"gross"``.
     """
 
     capabilities = Capabilities(partial_slip=True, subsurface=True, debris=True,
-                                contacts=("point",))
+                                contacts=("point", "line"))
 
     def __init__(
         self,
@@ -129,6 +148,7 @@ class HalfSpaceSolver(FirstBodySolver):
         window_radii: float = 10.0,
         tolerance: float = 1e-10,
         regime: str = "gross",
+        contact: Literal["point", "line"] | None = None,
     ) -> None:
         if (upper is None) != (lower is None):
             raise ValueError("upper and lower must both be given or both be None (defaults)")
@@ -151,10 +171,37 @@ class HalfSpaceSolver(FirstBodySolver):
         self.tolerance = _check_positive("tolerance", tolerance)
         self.modulus = contact_modulus(self.upper_material, self.lower_material)
         self.beta = dundurs_beta(self.upper_material, self.lower_material)
+        if contact not in (None, "point", "line"):
+            raise ValueError(f"contact = {contact!r} is not allowed: use 'point', 'line' or "
+                             "None (found from the surfaces)")
         if window is None:
-            a = _estimate_contact_radius(upper, lower, self.load, self.modulus)
-            window = _check_positive("window_radii", window_radii) * a
+            k = _check_positive("window_radii", window_radii)
+            kx, ky = _curvatures(upper, lower)
+            if contact == "line" or (contact is None and kx > 0 and ky == 0.0):
+                if not kx > 0:
+                    raise ValueError("window is None but the line contact's summed recession "
+                                     f"has no positive curvature along x (kx = {kx:.3g} 1/m):"
+                                     " give window (m) explicitly")
+                window = line_window(1.0 / kx, self.load, self.modulus, k)
+            else:
+                window = k * _estimate_contact_radius(upper, lower, self.load, self.modulus)
         self.dx = _check_positive("window", window) / self.n
+        g0 = self.gap(0.0)
+        along_y = float(np.ptp(g0, axis=1).max())
+        flat_y = along_y <= 1e-12 * max(float(np.ptp(g0)), 1e-300)
+        if contact == "line" and not flat_y:
+            raise ValueError(f"contact = 'line' but the summed recession varies by {along_y:.3g}"
+                             " m along y on the window: a line contact's surfaces must not "
+                             "depend on y (axis along y)")
+        #: the contact type: "line" (periodic along y, plane strain) or "point"
+        self.contact: Literal["point", "line"] = contact or ("line" if flat_y else "point")
+        if self.contact not in type(self).capabilities.contacts:
+            raise ValueError(f"a {self.contact} contact is not solved by {type(self).__name__}"
+                             f" (it solves: {', '.join(type(self).capabilities.contacts)})")
+        if self.contact == "line" and self.regime != "gross":
+            raise ValueError(f"regime = {self.regime!r} is not allowed for a line contact: the "
+                             "Ciavarella-Jaeger superposition here uses the point contact's "
+                             "rigid approach, undefined for a line contact; use 'gross'")
         self._model = tm.ModelFactory.createModel(
             tm.model_type.basic_2d, [1.0, 1.0], [self.n, self.n]
         )
@@ -251,6 +298,9 @@ class HalfSpaceSolver(FirstBodySolver):
             self._debris_load = 0.0
             self._debris_u = np.zeros((n, n))
             return
+        if self.contact == "line":
+            raise ValueError("a debris pressure is not available for a line contact (its "
+                             "displacement here is the non-periodic point-contact integral)")
         pd = np.asarray(pressure, dtype=float)
         if pd.shape != (n, n) or not np.all(np.isfinite(pd)) or pd.min() < 0:
             raise ValueError(f"debris pressure: shape {pd.shape}, min {np.nanmin(pd):.3g}: "
@@ -314,7 +364,11 @@ class HalfSpaceSolver(FirstBodySolver):
         return p, gap
 
     def _check_window(self, p: NDArray[np.float64], offset: float) -> None:
-        edge = max(p[0].max(), p[-1].max(), p[:, 0].max(), p[:, -1].max())
+        """Refuse a contact on the window edge: all four for a point contact, the two x
+        edges for a line contact (periodic along y by design)."""
+        edge = max(p[0].max(), p[-1].max())
+        if self.contact == "point":
+            edge = max(edge, p[:, 0].max(), p[:, -1].max())
         if edge > 0.0:
             raise WindowTooSmallError(
                 f"contact touches the window edge at offset {offset:.4g} m (window "
@@ -423,7 +477,8 @@ class HalfSpaceSolver(FirstBodySolver):
     ) -> SubsurfaceStress:
         """Stress under ``body`` for a solved increment (frame: x, y, z = depth into body).
 
-        ``depth`` defaults to 3 equivalent contact radii sqrt(area / pi). The lower body's
+        ``depth`` defaults to 3 equivalent contact radii sqrt(area / pi) (line contact: 3
+        half-widths, area / (2 window)). The lower body's
         window centre lies at lab x = ``result.offset``. Shear traction applied: ``traction``
         on the upper body, ``-traction`` on the lower one.
         """
@@ -436,7 +491,9 @@ class HalfSpaceSolver(FirstBodySolver):
                 f"result.pressure has shape {result.pressure.shape}: expected ({self.n}, "
                 f"{self.n}) from this solver"
             )
-        if depth is None:
+        if depth is None and self.contact == "line":
+            depth = 3.0 * max(result.contact_area, self.dx**2) / (2.0 * self.window)
+        elif depth is None:
             depth = 3.0 * math.sqrt(max(result.contact_area, self.dx**2) / math.pi)
         depth = _check_positive("depth", depth)
         mat = self.upper_material if body == "upper" else self.lower_material
