@@ -7,12 +7,13 @@ from __future__ import annotations
 
 import inspect
 import json
+import math
 import time
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
 import typer
-from pydantic import BaseModel, ConfigDict, Field, field_validator
+from pydantic import BaseModel, ConfigDict, Field, ValidationInfo, field_validator, model_validator
 
 from tribodem import __version__
 from tribodem.contact import (
@@ -20,9 +21,18 @@ from tribodem.contact import (
     CAPABILITY_TEXT,
     ElasticBody,
     FirstBodySolver,
-    HertzSphere,
     contact_modulus,
-    crossed_cylinders,
+)
+from tribodem.contact.geometry import (
+    CrossedCylinders,
+    CylinderOnFlat,
+    FlatPunch,
+    Geometry,
+    HeightMap,
+    HeightMaps,
+    SphereOnFlat,
+    line_window,
+    load_height_map,
 )
 from tribodem.cyclejump import STRATEGIES, make_strategy
 from tribodem.fretting.criteria import (
@@ -60,11 +70,59 @@ class _Model(BaseModel):
     model_config = ConfigDict(extra="forbid")
 
 
-class ContactConfig(_Model):
-    """First-body case (DESIGN.md default: crossed 8 mm cylinders, 100 N, +-0.3 mm, mu 0.6)."""
+GeometryName = Literal["crossed_cylinders", "sphere_on_flat", "cylinder_on_flat", "flat_punch",
+                       "height_map"]
 
-    diameter: float = Field(8e-3, gt=0, description="cylinder diameter, m")
-    load: float = Field(100.0, gt=0, description="normal load, N")
+#: Each geometry's own ``[contact]`` fields (their defaults: the dataclasses of
+#: :mod:`tribodem.contact.geometry`); any other geometry field given is refused.
+GEOMETRY_FIELDS: dict[str, tuple[str, ...]] = {
+    "crossed_cylinders": ("radius_upper", "radius_lower", "diameter"),
+    "sphere_on_flat": ("radius",),
+    "cylinder_on_flat": ("radius", "load_per_length"),
+    "flat_punch": ("punch_radius", "edge_radius"),
+    "height_map": ("upper_map", "lower_map", "map_dx"),
+}
+_ALL_GEOMETRY_FIELDS = tuple(dict.fromkeys(f for fs in GEOMETRY_FIELDS.values() for f in fs))
+
+#: Default total normal load on the window, N (DESIGN.md default case).
+DEFAULT_LOAD = 100.0
+
+#: Window side when ``contact.window`` is left out, in contact radii (or half-widths).
+WINDOW_RADII = 10.0
+
+
+class ContactConfig(_Model):
+    """First-body case (DESIGN.md default: crossed 8 mm cylinders, 100 N, +-0.3 mm, mu 0.6).
+
+    ``geometry`` picks the case (docs/fretting.md, "Geometries"); its own fields left out
+    take the defaults of :mod:`tribodem.contact.geometry` and are filled in on validation
+    (the resolved config shows what ran). A field of another geometry is refused.
+    """
+
+    geometry: GeometryName = "crossed_cylinders"
+    diameter: float | None = Field(
+        None, gt=0, description="crossed_cylinders: both cylinders' diameter, m (shorthand for "
+        "radius_upper = radius_lower = diameter / 2; a radius given wins)")
+    radius_upper: float | None = Field(None, gt=0, description="crossed_cylinders: upper "
+                                       "cylinder's radius (axis along y), m")
+    radius_lower: float | None = Field(None, gt=0, description="crossed_cylinders: lower "
+                                       "cylinder's radius (axis along x), m")
+    radius: float | None = Field(None, gt=0, description="sphere_on_flat / cylinder_on_flat: "
+                                 "radius of the upper body, m")
+    punch_radius: float | None = Field(None, gt=0, description="flat_punch: radius of the "
+                                       "flat face, m")
+    edge_radius: float | None = Field(None, gt=0, description="flat_punch: edge radius, m")
+    upper_map: str | None = Field(None, description="height_map: upper body's surface "
+                                  "heights (.csv, .npy with map_dx; .stl)")
+    lower_map: str | None = Field(None, description="height_map: lower body's surface "
+                                  "heights (must cover the window plus the stroke along x)")
+    map_dx: float | None = Field(None, gt=0, description="height_map: grid spacing of CSV/NPY "
+                                 "maps (STL: sampling step, default its vertex spacing), m")
+    load: float | None = Field(None, gt=0, description="total normal load on the window, N "
+                               "(default 100 N; line contact: or load_per_length)")
+    load_per_length: float | None = Field(
+        None, gt=0, description="cylinder_on_flat: normal load per unit length of the "
+        "cylinder, N/m (instead of the total load over the window)")
     friction: float = Field(0.6, ge=0, description="friction coefficient")
     amplitude: float = Field(0.3e-3, gt=0, description="displacement amplitude, m")
     n_increments: int = Field(48, ge=4, description="increments per cycle (multiple of 4)")
@@ -72,8 +130,69 @@ class ContactConfig(_Model):
     n: int = Field(256, ge=16, le=2048, description="window points per side (even)")
     window: float | None = Field(None, gt=0, description="window side, m (None: 10 radii)")
     tolerance: float = Field(1e-6, gt=0, lt=1, description="normal solver (PKR) tolerance")
-    young: float = Field(EN24T.young, gt=0, description="Young's modulus (both bodies), Pa")
-    poisson: float = Field(EN24T.poisson, gt=-1, lt=0.5, description="Poisson's ratio")
+    young: float = Field(EN24T.young, gt=0, description="Young's modulus (both bodies unless "
+                         "young_upper / young_lower), Pa")
+    poisson: float = Field(EN24T.poisson, gt=-1, lt=0.5, description="Poisson's ratio (both "
+                           "bodies unless poisson_upper / poisson_lower)")
+    young_upper: float | None = Field(None, gt=0, description="upper body's Young's modulus, Pa")
+    poisson_upper: float | None = Field(None, gt=-1, lt=0.5, description="upper body's "
+                                        "Poisson's ratio")
+    young_lower: float | None = Field(None, gt=0, description="lower body's Young's modulus, Pa")
+    poisson_lower: float | None = Field(None, gt=-1, lt=0.5, description="lower body's "
+                                        "Poisson's ratio")
+
+    @field_validator(*_ALL_GEOMETRY_FIELDS)
+    @classmethod
+    def _of_geometry(cls, v: Any, info: ValidationInfo) -> Any:
+        geo = info.data.get("geometry")
+        name = info.field_name or ""
+        if v is None or geo is None or name in GEOMETRY_FIELDS[geo]:
+            return v
+        owners = [g for g, fs in GEOMETRY_FIELDS.items() if name in fs]
+        raise ValueError(
+            f"Extra inputs are not permitted with geometry = {geo!r}: {name} belongs to "
+            f"geometry = {' or '.join(repr(g) for g in owners)}; allowed for {geo!r}: "
+            f"{', '.join(GEOMETRY_FIELDS[geo])}")
+
+    @field_validator("load_per_length")
+    @classmethod
+    def _one_load(cls, v: float | None, info: ValidationInfo) -> float | None:
+        if v is not None and info.data.get("load") is not None:
+            raise ValueError(f"give load (total over the window, N; here "
+                             f"{info.data['load']!r}) or load_per_length (N/m), not both")
+        return v
+
+    @field_validator("upper_map", "lower_map")
+    @classmethod
+    def _absolute(cls, v: str | None) -> str | None:
+        return None if v is None else str(Path(v).expanduser().absolute())
+
+    @model_validator(mode="after")
+    def _fill_geometry(self) -> ContactConfig:
+        """Fill the geometry's own fields with their defaults (one definition each, in
+        :mod:`tribodem.contact.geometry`) and the load (100 N unless load_per_length)."""
+        if self.load is None and self.load_per_length is None:
+            self.load = DEFAULT_LOAD
+        geo = self.geometry
+        if geo == "crossed_cylinders":
+            d = CrossedCylinders()
+            half = None if self.diameter is None else self.diameter / 2
+            if self.radius_upper is None:
+                self.radius_upper = half if half is not None else d.radius_upper
+            if self.radius_lower is None:
+                self.radius_lower = half if half is not None else d.radius_lower
+        elif geo in ("sphere_on_flat", "cylinder_on_flat") and self.radius is None:
+            self.radius = (SphereOnFlat() if geo == "sphere_on_flat" else CylinderOnFlat()).radius
+        elif geo == "flat_punch":
+            fp = FlatPunch()
+            if self.punch_radius is None:
+                self.punch_radius = fp.punch_radius
+            if self.edge_radius is None:
+                self.edge_radius = fp.edge_radius
+        elif geo == "height_map" and self.upper_map is None and self.lower_map is None:
+            raise ValueError("geometry = 'height_map' needs upper_map or lower_map (a file "
+                             "of surface heights, m), or both")
+        return self
 
     @field_validator("n_increments")
     @classmethod
@@ -193,6 +312,13 @@ def build_criterion(cfg: FrettingConfig) -> Criterion:
     """The configured criterion; ``ConfigError`` when it cannot run."""
     w = cfg.wear
     name = w.criterion
+    up, lo = materials(cfg)
+    if name == "swt" and up != lo:
+        raise ConfigError(
+            f"wear.criterion = 'swt' takes one material for both bodies, but the upper body is "
+            f"(young {up.young:g} Pa, poisson {up.poisson:g}) and the lower one (young "
+            f"{lo.young:g} Pa, poisson {lo.poisson:g}); allowed: equal materials (young/"
+            "poisson only) or another criterion")
     stress = {"depth": w.stress_depth, "nz": w.stress_nz, "samples": w.stress_samples}
     params: dict[str, Any] = {
         "energy": {"alpha": w.alpha, "share_upper": w.energy_share_upper},
@@ -202,8 +328,7 @@ def build_criterion(cfg: FrettingConfig) -> Criterion:
         "shear": {"uts": w.uts, **stress},
         "dfdi": {"eps0": w.eps0, "depth": w.stress_depth},
         "swt": {"nz": w.swt_nz, "depth": w.stress_depth, "samples": w.stress_samples,
-                "plane_step": w.swt_plane_step, "young": cfg.contact.young,
-                "poisson": cfg.contact.poisson},
+                "plane_step": w.swt_plane_step, "young": lo.young, "poisson": lo.poisson},
     }.get(name, {})
     try:
         return make_criterion(name, **params)
@@ -217,35 +342,239 @@ def build_criterion(cfg: FrettingConfig) -> Criterion:
 MIN_WINDOW_RADII = 4.0
 
 
-def hertz_radius(cfg: FrettingConfig) -> float:
-    """Hertz contact radius of the unworn crossed cylinders, m: a = (3 P R / (4 E*))^(1/3),
-    R the cylinders' radius (equal crossed cylinders act as a sphere of that radius)."""
+def materials(cfg: FrettingConfig) -> tuple[ElasticBody, ElasticBody]:
+    """(upper, lower) bodies: ``young_upper``/``poisson_upper`` etc., else ``young``/
+    ``poisson`` for both (Pa, -)."""
     c = cfg.contact
-    mat = ElasticBody(young=c.young, poisson=c.poisson)
-    return HertzSphere(c.diameter / 2, c.load, contact_modulus(mat, mat)).contact_radius
+
+    def pick(v: float | None, both: float) -> float:
+        return both if v is None else v
+
+    try:
+        return (ElasticBody(pick(c.young_upper, c.young), pick(c.poisson_upper, c.poisson)),
+                ElasticBody(pick(c.young_lower, c.young), pick(c.poisson_lower, c.poisson)))
+    except ValueError as err:
+        raise ConfigError(f"contact: {err}") from None
 
 
-def check_window(cfg: FrettingConfig) -> None:
+def case_modulus(cfg: FrettingConfig) -> float:
+    """Contact modulus E* of the two bodies, Pa."""
+    return contact_modulus(*materials(cfg))
+
+
+def case_geometry(cfg: FrettingConfig) -> Geometry:
+    """The ``[contact]`` geometry as a :mod:`tribodem.contact.geometry` dataclass; height
+    maps are read here (``ConfigError`` naming the field and the file when unusable)."""
+    c = cfg.contact
+    try:
+        if c.geometry == "crossed_cylinders":
+            assert c.radius_upper is not None and c.radius_lower is not None
+            return CrossedCylinders(c.radius_upper, c.radius_lower)
+        if c.geometry == "sphere_on_flat":
+            assert c.radius is not None
+            return SphereOnFlat(c.radius)
+        if c.geometry == "cylinder_on_flat":
+            assert c.radius is not None
+            return CylinderOnFlat(c.radius)
+        if c.geometry == "flat_punch":
+            assert c.punch_radius is not None and c.edge_radius is not None
+            return FlatPunch(c.punch_radius, c.edge_radius)
+    except ValueError as err:
+        raise ConfigError(f"contact: {err}") from None
+    maps: dict[str, HeightMap | None] = {"upper": None, "lower": None}
+    for body in maps:
+        path = getattr(c, f"{body}_map")
+        if path is None:
+            continue
+        try:
+            maps[body] = load_height_map(path, body, c.map_dx)
+        except ValueError as err:
+            raise ConfigError(f"contact.{body}_map = {path!r}: {err}") from None
+    return HeightMaps(maps["upper"], maps["lower"])
+
+
+def _map_limits(geo: HeightMaps, n: int, amplitude: float, window: float
+                ) -> list[tuple[str, str, float, float]]:
+    """(field, axis, needed half-extent, available half-extent) of each map (m) for a
+    window ``window``: the upper map covers the window, the lower one the window plus the
+    stroke along x (the track grid)."""
+    dx = window / n
+    pad = math.ceil(amplitude / dx) + 1
+    out = []
+    for name, hm, px in (("upper_map", geo.upper, 0), ("lower_map", geo.lower, pad)):
+        if hm is None:
+            continue
+        x0, x1, y0, y1 = hm.extent
+        out.append((name, "x", (n // 2 + px) * dx, min(-x0, x1)))
+        out.append((name, "y", (n // 2) * dx, min(-y0, y1)))
+    return out
+
+
+def map_window(cfg: FrettingConfig, geo: HeightMaps) -> float:
+    """The largest window (m) the height maps cover (upper: the window; lower: the window
+    plus the stroke), for ``geometry = "height_map"`` without ``contact.window``."""
+    c = cfg.contact
+    w = min(2 * have for *_, have in _map_limits(geo, c.n, c.amplitude, 1.0)) or 1.0
+    for _ in range(200):
+        if all(need <= have * (1 + 1e-9) for *_, need, have in
+               _map_limits(geo, c.n, c.amplitude, w)):
+            return w
+        w *= 0.99
+    raise ConfigError(f"contact.lower_map = {c.lower_map!r}: the map is too short along x for "
+                      f"the stroke (amplitude {c.amplitude:g} m) plus a window")
+
+
+def case_window(cfg: FrettingConfig, geo: Geometry | None = None) -> float | None:
+    """The window side (m) the solver gets: ``contact.window``, else ``WINDOW_RADII`` contact
+    radii (line contact: half-widths; None = the solver's own estimate of the Hertz radius
+    from the surfaces' curvature, for crossed cylinders of equal radii and the sphere; height
+    maps: the largest window the maps cover)."""
+    c = cfg.contact
+    if c.window is not None:
+        return c.window
+    geo = case_geometry(cfg) if geo is None else geo
+    es = case_modulus(cfg)
+    if isinstance(geo, SphereOnFlat) or (isinstance(geo, CrossedCylinders)
+                                         and geo.radius_upper == geo.radius_lower):
+        return None
+    if isinstance(geo, CylinderOnFlat):
+        if c.load_per_length is not None:
+            return WINDOW_RADII * geo.hertz(c.load_per_length, es).half_width
+        assert c.load is not None
+        return line_window(geo.radius, c.load, es, WINDOW_RADII)
+    if isinstance(geo, HeightMaps):
+        return map_window(cfg, geo)
+    return WINDOW_RADII * max(geo.contact_size(total_load(cfg, None), es))
+
+
+def total_load(cfg: FrettingConfig, window: float | None) -> float:
+    """Total normal load on the window, N: ``load``, or ``load_per_length`` x window."""
+    c = cfg.contact
+    if c.load_per_length is not None:
+        assert window is not None
+        return c.load_per_length * window
+    assert c.load is not None
+    return c.load
+
+
+def contact_half_size(cfg: FrettingConfig, geo: Geometry | None = None,
+                      window: float | None = None) -> tuple[str, float] | None:
+    """(description, largest contact half-size along a checked direction, m) of the unworn
+    analytic geometry (None for height maps): Hertz radius (the larger semi-axis for
+    crossed cylinders of unequal radii), the line contact's half-width along x (P' =
+    load / window or load_per_length), the rounded punch's contact radius."""
+    c = cfg.contact
+    geo = case_geometry(cfg) if geo is None else geo
+    es = case_modulus(cfg)
+    if isinstance(geo, HeightMaps):
+        return None
+    if isinstance(geo, CylinderOnFlat):
+        pl = c.load_per_length
+        if pl is None:
+            assert c.load is not None and window is not None
+            pl = c.load / window
+        return (f"the Hertz line contact of the cylinder (R {geo.radius:g} m, P' {pl:.4g} N/m, "
+                f"E* {es:.4g} Pa) has half-width a", geo.hertz(pl, es).half_width)
+    load = total_load(cfg, window)
+    what = {"crossed_cylinders": "the Hertz contact of the crossed cylinders (R "
+                                 f"{getattr(geo, 'radius_upper', 0):g} and "
+                                 f"{getattr(geo, 'radius_lower', 0):g} m",
+            "sphere_on_flat": f"the Hertz contact of the sphere (R {getattr(geo, 'radius', 0):g} m",
+            "flat_punch": "the contact of the rounded flat punch (punch radius "
+                          f"{getattr(geo, 'punch_radius', 0):g} m, edge radius "
+                          f"{getattr(geo, 'edge_radius', 0):g} m"}[geo.name]
+    return f"{what}, load {load:g} N, E* {es:.4g} Pa) has radius a", max(
+        geo.contact_size(load, es))
+
+
+def hertz_radius(cfg: FrettingConfig) -> float:
+    """Contact radius (m) of the unworn analytic geometry (line contact: half-width; 0 for
+    height maps): for the default crossed cylinders a = (3 P R / (4 E*))^(1/3)."""
+    hs = contact_half_size(cfg, window=case_window(cfg))
+    return 0.0 if hs is None else hs[1]
+
+
+def check_window(cfg: FrettingConfig, geo: Geometry | None = None) -> None:
     """Refuse (``ConfigError``) a ``contact.window`` that cannot hold the contact.
 
-    The window travels with the upper body and the crossed-cylinder contact stays at its
-    centre through the stroke (the lower track grid covers the stroke separately), so the
-    window must hold the contact, diameter 2 a, with a margin of a on each side for the
-    periodic images and the contact's growth with wear: window >= 4 a.
+    The window travels with the upper body and the contact stays at its centre through the
+    stroke (the lower track grid covers the stroke separately), so the window must hold the
+    contact, width 2 a, with a margin of a on each side for the periodic images and the
+    contact's growth with wear: window >= 4 a, along every direction in which the contact
+    can reach an edge (a line contact, periodic along y by design: x only). Height maps:
+    the maps must cover the window (and the lower one the stroke); the contact itself is
+    checked by a solve (:func:`check_solved_window`).
     """
     c = cfg.contact
+    geo = case_geometry(cfg) if geo is None else geo
+    if isinstance(geo, HeightMaps):
+        w = case_window(cfg, geo)
+        assert w is not None
+        for field, axis, need, have in _map_limits(geo, c.n, c.amplitude, w):
+            if need > have * (1 + 1e-9):
+                raise ConfigError(
+                    f"contact.{field} = {getattr(c, field)!r}: the map spans +-{have:.4g} m "
+                    f"along {axis} about its centre but the window ({w:.4g} m"
+                    f"{'' if c.window is not None else ', contact.window left out'}"
+                    f"{', plus the stroke' if field == 'lower_map' and axis == 'x' else ''}"
+                    f") needs +-{need:.4g} m; allowed: a larger map or a smaller "
+                    "contact.window")
+        return
     if c.window is None:
         return
-    a = hertz_radius(cfg)
+    hs = contact_half_size(cfg, geo, c.window)
+    assert hs is not None
+    what, a = hs
     low = MIN_WINDOW_RADII * a
     if c.window < low:
-        mat = ElasticBody(young=c.young, poisson=c.poisson)
+        along = " along x (a line contact is periodic along y)" if geo.contact == "line" else ""
         raise ConfigError(
-            f"contact.window = {c.window!r} m cannot hold the contact: the Hertz contact of "
-            f"the crossed cylinders (load {c.load:g} N, E* {contact_modulus(mat, mat):.4g} Pa,"
-            f" R {c.diameter / 2:g} m) has radius a = {a:.4g} m; allowed: >= {low:.4g} m "
-            f"({MIN_WINDOW_RADII:g} a; the window travels with the upper body, so the stroke "
-            "does not enter), or leave it out for 10 a")
+            f"contact.window = {c.window!r} m cannot hold the contact: {what} = {a:.4g} m; "
+            f"allowed: >= {low:.4g} m ({MIN_WINDOW_RADII:g} a{along}; the window travels with "
+            f"the upper body, so the stroke does not enter), or leave it out for "
+            f"{WINDOW_RADII:g} a")
+
+
+def check_solved_window(cfg: FrettingConfig, solver: FirstBodySolver) -> None:
+    """For height maps (no analytic contact size): solve the loaded contact at offset 0 and
+    refuse (``ConfigError`` naming ``contact.window``) a contact on the window's edge along
+    a checked direction (solvers without a separate loaded solution: skipped)."""
+    try:
+        p, _ = solver.loaded_solution(0.0)
+    except NotImplementedError:
+        return
+    contact = getattr(solver, "contact", "point")
+    edge = max(p[0].max(), p[-1].max())
+    if contact == "point":
+        edge = max(edge, p[:, 0].max(), p[:, -1].max())
+    if edge > 0.0:
+        c = cfg.contact
+        raise ConfigError(
+            f"contact.window = {c.window!r} (window {solver.window:.4g} m) cannot hold the "
+            f"contact of the height maps: the loaded contact ({int((p > 0).sum())} of "
+            f"{p.size} points) reaches the window edge{' along x' if contact == 'line' else ''};"
+            " allowed: a larger contact.window (and maps covering it) or a smaller load")
+
+
+def case_summary(cfg: FrettingConfig, solver: FirstBodySolver) -> dict[str, Any]:
+    """What ran: geometry and its parameters, contact type, load (and which was given),
+    window, the two bodies and E* (SI)."""
+    c = cfg.contact
+    up, lo = materials(cfg)
+    contact = getattr(solver, "contact", "point")
+    out: dict[str, Any] = {
+        "geometry": c.geometry, "contact": contact,
+        "parameters": {k: getattr(c, k) for k in GEOMETRY_FIELDS[c.geometry]
+                       if getattr(c, k) is not None},
+        "load_given": "load_per_length" if c.load_per_length is not None else "load",
+        "load_total_N": solver.load, "window_m": solver.window,
+        "upper": {"young_Pa": up.young, "poisson": up.poisson},
+        "lower": {"young_Pa": lo.young, "poisson": lo.poisson},
+        "modulus_Pa": solver.modulus,
+    }
+    if contact == "line":
+        out["load_per_length_N_per_m"] = solver.load / solver.window
+    return out
 
 
 def check_jump_params(strategy: str, params: dict[str, Any]) -> None:
@@ -270,6 +599,14 @@ def check_compatible(cfg: FrettingConfig) -> None:
     have = backend.capabilities.names()
     crit = CRITERIA[cfg.wear.criterion]
     needs = [(f"wear.criterion = {cfg.wear.criterion!r}", crit.requires)]
+    if cfg.contact.geometry == "cylinder_on_flat":
+        needs.append(("contact.geometry = 'cylinder_on_flat' (a line contact)",
+                      frozenset({"line_contact"})))
+        if cfg.debris.every is not None:
+            raise ConfigError(
+                f"debris.every = {cfg.debris.every!r}: the debris third body is not available "
+                "for contact.geometry = 'cylinder_on_flat' (a line contact); allowed: leave "
+                "debris.every out (or --no-debris)")
     if cfg.cycles > 1 and crit.requires_over_cycles:
         needs.append((f"wear.criterion = {cfg.wear.criterion!r} over cycles = {cfg.cycles} "
                       "(allowed with this solver: cycles = 1)", crit.requires_over_cycles))
@@ -289,14 +626,20 @@ def check_compatible(cfg: FrettingConfig) -> None:
 def build_solver(cfg: FrettingConfig) -> FirstBodySolver:
     """The configured first-body backend (:data:`tribodem.contact.BACKENDS`) on the case."""
     c = cfg.contact
-    mat = ElasticBody(young=c.young, poisson=c.poisson)
+    up, lo = materials(cfg)
     backend = BACKENDS[cfg.solver]
-    upper, lower = crossed_cylinders(c.diameter)
+    geo = case_geometry(cfg)
+    upper, lower = geo.recessions()
+    window = case_window(cfg, geo)
+    if c.load_per_length is not None and window is None:
+        raise ConfigError("contact.load_per_length needs a window (m)")
     kw: dict[str, Any] = dict(
-        load=c.load, friction=c.friction, upper_material=mat, lower_material=mat,
-        n=c.n, window=c.window, regime=c.regime, tolerance=c.tolerance)
+        load=total_load(cfg, window), friction=c.friction, upper_material=up,
+        lower_material=lo, n=c.n, window=window, regime=c.regime, tolerance=c.tolerance)
     if backend.capabilities.plastic:
         kw |= cfg.plastic.model_dump()
+    if "line" in backend.capabilities.contacts and not isinstance(geo, HeightMaps):
+        kw["contact"] = geo.contact
     try:
         return backend(upper, lower, **kw)
     except ValueError as err:
@@ -310,6 +653,8 @@ def build_loop(cfg: FrettingConfig) -> FrettingLoop:
     crit = build_criterion(cfg)
     c = cfg.contact
     solver = build_solver(cfg)
+    if c.geometry == "height_map":
+        check_solved_window(cfg, solver)
     strategy = None
     if cfg.jump.strategy != "none":
         check_jump_params(cfg.jump.strategy, cfg.jump.params)
@@ -324,7 +669,8 @@ def build_loop(cfg: FrettingConfig) -> FrettingLoop:
     if cfg.debris.every is not None:
         dc = cfg.debris.model_dump(exclude={"every"})
         try:
-            debris = DebrisField(DebrisSettings(young=c.young, poisson=c.poisson, **dc))
+            lo = materials(cfg)[1]  # the debris takes the lower body's (the track's) material
+            debris = DebrisField(DebrisSettings(young=lo.young, poisson=lo.poisson, **dc))
         except ValueError as err:
             raise ConfigError(str(err)) from None
     try:
@@ -347,6 +693,12 @@ def resolve_config(config: Path | None, quick: bool = False,
     if config is not None:
         data: dict[str, Any] = load_toml(config)
         source = str(config)
+        contact = data.get("contact")
+        if isinstance(contact, dict):  # height maps: relative to the config file
+            for key in ("upper_map", "lower_map"):
+                v = contact.get(key)
+                if isinstance(v, str) and not Path(v).expanduser().is_absolute():
+                    contact[key] = str(Path(config).parent / v)
     else:
         data, source = dict(base or {}), "command line"
     if quick:
@@ -468,6 +820,7 @@ def run_fretting(cfg: FrettingConfig, out: Path, echo: Any = None, resume: bool 
         "jump": {"strategy": cfg.jump.strategy,
                  **({"params": loop.strategy.params()} if loop.strategy else {})},
         "window_m": loop.solver.window,
+        "contact_case": case_summary(cfg, loop.solver),
         "wall_time_total_s": time.perf_counter() - t0,
         "files": files,
         "config": resolved,
