@@ -146,6 +146,10 @@ def _ci(pct: float, half: float) -> str:
     return _fmt(pct) if not np.isfinite(half) else f"{pct:+.1f} +- {half:.1f}%"
 
 
+def _sd(x: float, fmt: str) -> str:
+    return format(x, fmt) if np.isfinite(x) else "-"
+
+
 def _num(x: float) -> float | None:
     return float(x) if x is not None and np.isfinite(x) else None
 
@@ -273,8 +277,8 @@ def write_comparison(out: Path, runs: dict[int, list[tuple[dict[str, Any], Path]
         per.append(f"| {k} | {c.load_kN:g} | {r['pressure_Pa'] / 1e6:.4g} | {c.rpm:g} | "
                    f"{r['sliding_speed_m_s']:.4g} | {r['simulated_time_s'] * 1e6:.3g} | "
                    f"{r['simulated_sliding_distance_m'] * 1e6:.4g} | "
-                   f"{wear[k] * 1e6:.2f} +- {spread[k] * 1e6:.2f} | "
-                   f"{rate[k] * 1e3:.3g} +- {rate_sd[k] * 1e3:.2g} | "
+                   f"{wear[k] * 1e6:.2f} +- {_sd(spread[k] * 1e6, '.2f')} | "
+                   f"{rate[k] * 1e3:.3g} +- {_sd(rate_sd[k] * 1e3, '.2g')} | "
                    f"{contact[k]:.3f} | "
                    f"{r['wear_depth_max_m'] * 1e6:.1f} | "
                    f"{r['wear_depth_mean_disc_m'] * 1e6:.2f} | {r['broken_bonds']:.0f} "
@@ -340,7 +344,8 @@ def write_comparison(out: Path, runs: dict[int, list[tuple[dict[str, Any], Path]
         "",
         f"Our change = change of the means over {n_seeds} packing(s) +- the half-width of "
         "the two-sided 95% Student-t interval of the paired per-packing changes "
-        f"({_factor(n_seeds):.2f} standard errors, {max(n_seeds - 1, 0)} degrees of freedom). "
+        + (f"({_factor(n_seeds):.2f} standard errors, {n_seeds - 1} degrees of freedom). "
+           if n_seeds > 1 else "(none with one packing: use --packings N). ") +
         "'seed inside' (comparison.json `reproduced`): the seed's change lies inside our "
         "interval, |seed - ours| <= half-width; 'verdict': our interval excludes 0 "
         "(up/down) or not (not resolved).",
