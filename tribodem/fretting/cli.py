@@ -12,6 +12,7 @@ import time
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
+import numpy as np
 import typer
 from pydantic import BaseModel, ConfigDict, Field, ValidationInfo, field_validator, model_validator
 
@@ -539,6 +540,16 @@ def check_solved_window(cfg: FrettingConfig, solver: FirstBodySolver) -> None:
     """For height maps (no analytic contact size): solve the loaded contact at offset 0 and
     refuse (``ConfigError`` naming ``contact.window``) a contact on the window's edge along
     a checked direction (solvers without a separate loaded solution: skipped)."""
+    c = cfg.contact
+    xw, yw = np.meshgrid(solver.coords, solver.coords, indexing="ij")
+    gap = np.asarray(solver.upper(xw, yw) + solver.lower(xw, yw), dtype=float)
+    if float(np.ptp(gap)) <= 0.0:
+        given = ", ".join(f"contact.{k} = {getattr(c, k)!r}" for k in ("upper_map", "lower_map")
+                          if getattr(c, k) is not None)
+        raise ConfigError(
+            f"{given}: the surfaces are flat on the window ({solver.window:.4g} m): the "
+            "contact would fill the window (contact.window cannot hold it); allowed: maps "
+            "with a contact spot (curved or rough surfaces)")
     try:
         p, _ = solver.loaded_solution(0.0)
     except NotImplementedError:
@@ -548,7 +559,6 @@ def check_solved_window(cfg: FrettingConfig, solver: FirstBodySolver) -> None:
     if contact == "point":
         edge = max(edge, p[:, 0].max(), p[:, -1].max())
     if edge > 0.0:
-        c = cfg.contact
         raise ConfigError(
             f"contact.window = {c.window!r} (window {solver.window:.4g} m) cannot hold the "
             f"contact of the height maps: the loaded contact ({int((p > 0).sum())} of "
