@@ -223,6 +223,10 @@ def _refused(tmp_path: Path, toml: str, *expect: str) -> None:
      ("contact.window", "0.0001")),
     ("line window", '[contact]\ngeometry = "cylinder_on_flat"\nload_per_length = 1e5\n'
      'window = 1e-4\n', ("contact.window", "0.0001", "along x")),
+    ("line partial slip", '[contact]\ngeometry = "cylinder_on_flat"\n'
+     'regime = "ciavarella-jaeger"\n', ("regime = 'ciavarella-jaeger'", "line contact")),
+    ("line debris", '[contact]\ngeometry = "cylinder_on_flat"\n[debris]\nevery = 2\n',
+     ("debris.every = 2", "line contact")),
     ("line on elastic-plastic", 'solver = "elastic-plastic"\n[contact]\n'
      'geometry = "cylinder_on_flat"\n', ("contact.geometry", "line_contact")),
 ])
