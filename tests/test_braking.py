@@ -348,3 +348,12 @@ def test_until_steady_with_a_load_ramp_resumes_bitwise(tmp_path: Path,
             assert repr(res[k]) == repr(v), k
     assert (tmp_path / "a" / "timeseries.csv").read_bytes() == \
         (tmp_path / "b" / "timeseries.csv").read_bytes()
+
+
+def test_braking_example_configs_resolve() -> None:
+    from tribodem.braking.cli import _config, setup_from_config
+
+    root = Path(__file__).resolve().parents[1] / "examples"
+    for name in ("braking_steady.toml", "braking_wide.toml"):
+        s = setup_from_config(_config(5, root / name, False))
+        assert s.until_steady and s.max_distance_m > 0, name
