@@ -180,7 +180,8 @@ class FirstBodySolver(ABC):
     relative tangential position at a time, in path order (the solver may keep load history
     between calls). The contract:
 
-    - data: ``n``, ``dx`` (window grid), ``load`` (N), ``modulus`` (E*, Pa),
+    - data: ``n``, ``dx`` (window grid), ``load`` (N), ``modulus`` (E*, Pa), ``contact``
+      (``"point"`` or ``"line"``),
       ``upper``/``lower`` (recessions, m:
       the surfaces the next solve sees), ``capabilities``;
     - :meth:`set_surfaces` (worn geometry), :meth:`reset`, :meth:`begin_cycle`,
@@ -202,6 +203,8 @@ class FirstBodySolver(ABC):
     load: float
     #: contact modulus E* of the two bodies, Pa (the scale of elastic deformation)
     modulus: float
+    #: the contact being solved: "point" or "line" (plane strain, periodic along y)
+    contact: str = "point"
     #: recessions of the two surfaces (m), as the next solve sees them
     upper: Recession
     lower: Recession

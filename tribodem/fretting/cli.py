@@ -554,7 +554,7 @@ def check_solved_window(cfg: FrettingConfig, solver: FirstBodySolver) -> None:
         p, _ = solver.loaded_solution(0.0)
     except NotImplementedError:
         return
-    contact = getattr(solver, "contact", "point")
+    contact = solver.contact
     edge = max(p[0].max(), p[-1].max())
     if contact == "point":
         edge = max(edge, p[:, 0].max(), p[:, -1].max())
@@ -571,7 +571,7 @@ def case_summary(cfg: FrettingConfig, solver: FirstBodySolver) -> dict[str, Any]
     window, the two bodies and E* (SI)."""
     c = cfg.contact
     up, lo = materials(cfg)
-    contact = getattr(solver, "contact", "point")
+    contact = solver.contact
     out: dict[str, Any] = {
         "geometry": c.geometry, "contact": contact,
         "parameters": {k: getattr(c, k) for k in GEOMETRY_FIELDS[c.geometry]

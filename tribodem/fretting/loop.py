@@ -360,13 +360,20 @@ class FrettingLoop:
 
         The approach of the last simulated cycle's contact, 3 P / (4 a E*) with a the radius
         of its mean contact area (Hertz: a^2 / R), is the scale on which a change of the
-        gap changes the pressure by its own order; the depth increment is that cycle's."""
+        gap changes the pressure by its own order; the depth increment is that cycle's. A
+        line contact (no finite approach in a half-space) takes b^2 / R = 4 P' / (pi E*),
+        P' the load per unit length of the periodic window."""
         tol = self.geometry_tolerance
         inc = max(float(self._last_du.max(initial=0.0)), float(self._last_dl.max(initial=0.0)))
         if tol is None or inc <= 0.0:
             return 1 << 62
-        a = math.sqrt(max(float(per.get("contact_area_m2", 0.0)), self.grid.cell_area) / math.pi)
-        approach = 3.0 * self.solver.load / (4.0 * a * self.solver.modulus)
+        sol = self.solver
+        if sol.contact == "line":  # b^2 / R = 4 P' / (pi E*), P' the load per unit length
+            approach = 4.0 * sol.load / (math.pi * sol.modulus * sol.window)
+        else:
+            a = math.sqrt(max(float(per.get("contact_area_m2", 0.0)), self.grid.cell_area)
+                          / math.pi)
+            approach = 3.0 * sol.load / (4.0 * a * sol.modulus)
         return int(tol * approach / inc)
 
     @property
