@@ -27,7 +27,10 @@ app = typer.Typer(
 
 def _version(value: bool) -> None:
     if value:
+        from tribodem.contact.cli import ccx_version
+
         typer.echo(f"tribodem {__version__}")
+        typer.echo(ccx_version())
         raise typer.Exit()
 
 
@@ -47,6 +50,7 @@ COMMANDS: dict[str, tuple[str, str, bool]] = {
     "jump": ("tribodem.cyclejump.cli", "jump_app", True),
     "fretting": ("tribodem.fretting.cli", "fretting_app", True),
     "braking": ("tribodem.braking.cli", "braking_app", True),
+    "validate": ("tribodem.contact.cli", "validate", False),
 }
 
 

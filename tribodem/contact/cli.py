@@ -1,0 +1,69 @@
+"""``tribodem validate``: each first-body backend against closed-form contact mechanics."""
+
+from __future__ import annotations
+
+import json
+import shutil
+import tempfile
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from tribodem.io.config import ConfigError
+
+#: backends with closed-form checks
+SOLVERS = ("elastic", "fe")
+
+
+def validate(
+    solver: Annotated[str, typer.Option("--solver", help=f"One of: {', '.join(SOLVERS)}.")]
+    = "elastic",
+    as_json: Annotated[bool, typer.Option("--json", help="A JSON list of checks.")] = False,
+    keep: Annotated[Path | None, typer.Option(
+        "--keep", help="fe: keep the CalculiX jobs in this folder.")] = None,
+) -> None:
+    """Closed-form checks of a first-body backend: Hertz (point, line), Cattaneo-Mindlin,
+    gross slip, first yield. Errors are relative, absolute (m) where the name says (m).
+    Exit 0 when every check passes, 3 otherwise."""
+    from tribodem.io.runs import RunStopped
+
+    if solver not in SOLVERS:
+        raise ConfigError(f"--solver = {solver!r}: allowed: {', '.join(SOLVERS)}")
+    if solver == "fe":
+        if shutil.which("ccx") is None:
+            raise ConfigError("--solver = 'fe' needs CalculiX's ccx, which is not on PATH; "
+                              "install it with: apt-get install -y calculix-ccx")
+        from tribodem.contact.fe.validate import validate_fe
+
+        with tempfile.TemporaryDirectory(prefix="tribodem_fe_") as tmp:
+            checks = validate_fe(keep or tmp, threads=1)
+    else:
+        from tribodem.contact.validate import halfspace_checks
+
+        checks = halfspace_checks()
+    if as_json:
+        typer.echo(json.dumps(checks, indent=2))
+    else:
+        for c in checks:
+            mark = "ok  " if c["pass"] else "FAIL"
+            typer.echo(f"{mark} {c['name']}: {c['value']:.6g} vs {c['reference']:.6g} "
+                       f"(error {c['error']:.3g}, tolerance {c['tolerance']:.3g})")
+    failed = [c["name"] for c in checks if not c["pass"]]
+    if failed:
+        raise RunStopped(f"{len(failed)} check(s) failed: {', '.join(failed)}")
+
+
+def ccx_version() -> str:
+    """The CalculiX ``ccx`` found on PATH (its version line), or how to install it."""
+    import subprocess
+
+    exe = shutil.which("ccx")
+    if exe is None:
+        return "ccx: not found (apt-get install -y calculix-ccx)"
+    try:
+        out = subprocess.run([exe, "-v"], capture_output=True, text=True, timeout=10).stdout
+    except (OSError, subprocess.TimeoutExpired):
+        return f"ccx: {exe} (version unknown)"
+    line = next((x.strip() for x in out.splitlines() if "Version" in x), "version unknown")
+    return f"ccx: {exe} ({line})"
