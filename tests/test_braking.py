@@ -313,14 +313,16 @@ def test_until_steady_with_a_load_ramp_resumes_bitwise(tmp_path: Path,
                                                        monkeypatch: pytest.MonkeyPatch
                                                        ) -> None:
     """A run that slides past its duration (never steady at a 1e-9 tolerance, so up to its
-    distance cap) under a load ramp, interrupted inside the ramp after its first extension
+    distance cap) under a load ramp and a sliding-speed ramp, interrupted inside both ramps
+    after its first extension
     and resumed: bitwise the uninterrupted run; the summary reports the steady-state and
     contact fields."""
     import tribodem.braking.run as run_mod
     from tribodem.braking.run import read_checkpoint
 
     change = {"duration_s": 0.5e-6, "samples": 10, "vtk_snapshots": 0, "until_steady": True,
-              "steady_tolerance": 1e-9, "max_distance_m": 47.12 * 0.8e-6, "ramp_s": 0.75e-6}
+              "steady_tolerance": 1e-9, "max_distance_m": 47.12 * 0.8e-6, "ramp_s": 0.75e-6,
+              "speed_ramp_s": 0.7e-6}
     full = run_braking(_tiny(change), tmp_path / "a")
     assert full["simulated_sliding_distance_m"] == pytest.approx(47.12 * 0.8e-6, rel=0.02)
     assert full["steady_reached"] is False and 0 <= full["contact_fraction"] <= 1

@@ -101,6 +101,10 @@ class RunCfg(_Strict):
     ramp_s: float = Field(0.0, ge=0, le=1e-2,
                           description="load ramped linearly from 0 over this sliding time "
                                       "(s); 0 = the full load at once")
+    speed_ramp_s: float = Field(0.0, ge=0, le=1e-2,
+                                description="the disc starts at rest under the loaded pad "
+                                            "and reaches the speed linearly over this "
+                                            "time (s); 0 = at speed from the start")
     checkpoint_every: int = Field(
         0, ge=0, le=100_000,
         description="samples between checkpoints (checkpoint.npz in the output folder); "
@@ -183,7 +187,8 @@ def setup_from_config(cfg: BrakingConfig) -> Any:
                     thermal_curve=curve, thermal_time_map=cfg.thermal.time_map,
                     figures=r.figures, checkpoint_every=r.checkpoint_every,
                     until_steady=r.until_steady, max_distance_m=r.max_distance_m,
-                    steady_tolerance=r.steady_tolerance, ramp_s=r.ramp_s)
+                    steady_tolerance=r.steady_tolerance, ramp_s=r.ramp_s,
+                    speed_ramp_s=r.speed_ramp_s)
 
 
 #: config fields a resumed run may change (they do not change the results)

@@ -105,6 +105,9 @@ class RunSetup:
     #: applying the load: the full target at once (``0``) or ramped linearly from 0 over
     #: ``ramp_s`` seconds of sliding (the pad applied as a hydraulic pressure builds up)
     ramp_s: float = 0.0
+    #: sliding ramped up: the disc starts at rest under the pad (full load) and its speed
+    #: rises linearly to ``speed_m_s`` over ``speed_ramp_s`` seconds (0: at speed at once)
+    speed_ramp_s: float = 0.0
 
 
 class _Loop:
@@ -113,7 +116,8 @@ class _Loop:
     state (``record``: JSON-able, ``arrays``: numpy) into the engine checkpoint through
     ``state``/``set_state``, so one atomic file holds everything a resumed run needs."""
 
-    def __init__(self, iface: Interface, ramp_steps: int = 0) -> None:
+    def __init__(self, iface: Interface, ramp_steps: int = 0, speed_ramp_steps: int = 0,
+                 speed: float = 0.0) -> None:
         self.iface = iface
         self.total = 0.0
         self.n = 0
@@ -124,6 +128,8 @@ class _Loop:
         # contact accounting every CONTACT_EVERY steps: looks, looks with load through the
         # interface, sum of the interface load / target
         self.contact = np.zeros(3)
+        self.speed_steps, self.speed = speed_ramp_steps, speed
+        self.distance = 0.0  # m slid by the disc's anchored layer
         self.apply()
 
     def apply(self) -> None:
@@ -140,6 +146,10 @@ class _Loop:
         if self.n % CONTACT_EVERY == 0:
             load = interface_load(self.iface)
             self.contact += (1.0, float(load > 0.0), load / self.full)
+        f = min(1.0, (self.n + 1) / self.speed_steps) if self.speed_steps else 1.0
+        if self.speed_steps and self.n < self.speed_steps:  # used by this step's advance
+            sim.p.vel[self.iface.anchor_disc, 0] = -self.speed * f
+        self.distance += self.speed * f * sim.dt
         self.n += 1
         if self.ramp_steps and self.n <= self.ramp_steps:
             self.apply()
@@ -153,6 +163,7 @@ class _Loop:
         out = {f"a_{k}": v for k, v in self.arrays.items()}
         out["wall"] = np.array([self.total, float(self.n)])
         out["contact"] = self.contact.copy()
+        out["distance"] = np.array([self.distance])
         out[LOOP_KEY] = np.array(json.dumps(self.record))
         return out
 
@@ -161,6 +172,7 @@ class _Loop:
         self.total, n = (float(x) for x in s["wall"])
         self.n = int(n)
         self.contact = np.array(s["contact"], dtype=np.float64)
+        self.distance = float(s["distance"][0])
         self.apply()
         self.record = json.loads(str(s[LOOP_KEY]))
         self.arrays = {k[2:]: np.array(v) for k, v in s.items() if k.startswith("a_")}
@@ -369,13 +381,21 @@ def run_braking(setup: RunSetup, out: Path | None = None, *, resume: bool = Fals
         _thermal(iface, setup, t0)
     start_sliding(iface, setup.speed_m_s)
     ref = reference(iface)
-    loop = _Loop(iface, int(math.ceil(setup.ramp_s / sim.dt)) if setup.ramp_s > 0 else 0)
+    speed_steps = int(math.ceil(setup.speed_ramp_s / sim.dt)) if setup.speed_ramp_s > 0 else 0
+    if speed_steps:  # the disc starts at rest under the pad
+        sim.p.vel[sim.p.group == DISC, 0] = 0.0
+    loop = _Loop(iface, int(math.ceil(setup.ramp_s / sim.dt)) if setup.ramp_s > 0 else 0,
+                 speed_steps, setup.speed_m_s)
     sim.add_interaction(loop)
     wall_y0 = float(iface.wall.point[1])
     min_steps = max(1, int(math.ceil(setup.duration_s / sim.dt)))
     total_steps = min_steps
-    cap_steps = max(min_steps, int(math.ceil(max_distance(setup) / (setup.speed_m_s * sim.dt)))
-                    ) if setup.until_steady else min_steps
+    cap_steps = max(min_steps, int(math.ceil(max_distance(setup) / (setup.speed_m_s * sim.dt)
+                                             + speed_steps / 2))) if setup.until_steady \
+        else min_steps
+
+    def slid_now() -> float:
+        return loop.distance if speed_steps else setup.speed_m_s * (sim.time - t0)
     block = max(1, int(math.ceil(0.2 * min_steps)))
     ended = False
     every = max(1, total_steps // max(1, setup.samples))
@@ -394,7 +414,7 @@ def run_braking(setup: RunSetup, out: Path | None = None, *, resume: bool = Fals
     def sample() -> None:
         nonlocal k_vtk
         t = sim.time - t0
-        slid = setup.speed_m_s * t
+        slid = slid_now()
         row = {"time_s": t, "sliding_distance_m": slid,
                "wall_force_N": plate_force(iface),
                "wall_pressure_Pa": plate_force(iface) / (iface.width * iface.disc.thickness),
@@ -502,7 +522,7 @@ def run_braking(setup: RunSetup, out: Path | None = None, *, resume: bool = Fals
                 done += k
                 sample()
                 if "early" not in frames and done >= 0.1 * total_steps:
-                    frames["early"] = _frame(iface, ref, setup.speed_m_s * (sim.time - t0))
+                    frames["early"] = _frame(iface, ref, slid_now())
                 bar.update(k)
                 if out is None or done >= total_steps:
                     continue
@@ -526,7 +546,7 @@ def run_braking(setup: RunSetup, out: Path | None = None, *, resume: bool = Fals
                 "last_checkpoint": str(ck) if ck is not None and ck.is_file() else None})
         raise
     if "end" not in frames:
-        frames["end"] = _frame(iface, ref, setup.speed_m_s * (sim.time - t0))
+        frames["end"] = _frame(iface, ref, slid_now())
     if out is not None and not resumed_finished:
         save_checkpoint()  # the finished state: a later --resume only reports it
     slide_wall = wall_before["sliding"] + time.perf_counter() - t_slide
@@ -550,7 +570,7 @@ def run_braking(setup: RunSetup, out: Path | None = None, *, resume: bool = Fals
         "pressure_Pa": setup.pressure_Pa,
         "speed_rpm": speed_to_rpm(setup.speed_m_s),
         "sliding_speed_m_s": setup.speed_m_s,
-        "simulated_sliding_distance_m": setup.speed_m_s * t_sim,
+        "simulated_sliding_distance_m": slid_now(),
         "simulated_time_s": t_sim,
         "equivalent_braking_time_s": t_sim,
         "seed_braking_time_s": SEED_BRAKING_TIME_S,
@@ -586,6 +606,7 @@ def run_braking(setup: RunSetup, out: Path | None = None, *, resume: bool = Fals
                                        "the interface carries load",
         "interface_load_ratio_mean": loop.contact[2] / looks,
         "ramp_s": setup.ramp_s,
+        "speed_ramp_s": setup.speed_ramp_s,
         "wear_depth_mean_extrapolated_8s_m": h8,
         "particles_initial": n0,
         "particles_final": int(inside.sum()),
