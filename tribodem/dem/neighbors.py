@@ -73,6 +73,7 @@ def _grid(pos, radius, lo_box, hi_box, periodic, cell_min):
 
 @njit(cache=True)
 def _bin(pos, lo, csize, ncell, periodic):
+    """Cell of every particle and the particles of each cell (counting sort)."""
     n = pos.shape[0]
     cell = np.empty(n, dtype=np.int64)
     for i in range(n):
@@ -89,17 +90,7 @@ def _bin(pos, lo, csize, ncell, periodic):
             c += ck * mult
             mult *= ncell[k]
         cell[i] = c
-    ntot = ncell[0] * ncell[1] * ncell[2]
-    cstart = np.zeros(ntot + 1, dtype=np.int64)
-    for i in range(n):
-        cstart[cell[i] + 1] += 1
-    for c in range(ntot):
-        cstart[c + 1] += cstart[c]
-    fill = cstart[:-1].copy()
-    order = np.empty(n, dtype=np.int64)
-    for i in range(n):
-        order[fill[cell[i]]] = i
-        fill[cell[i]] += 1
+    cstart, order = _bucket(cell, ncell[0] * ncell[1] * ncell[2])
     return cell, cstart, order
 
 
@@ -171,20 +162,27 @@ def _sort_rows(start, pj):
 
 
 @njit(cache=True)
+def _bucket(keys, nkeys):
+    """Counting sort: ``start[k]:start[k+1]`` are the positions in ``order`` of the items
+    whose key is k, in increasing item order (stable, no comparisons)."""
+    m = keys.shape[0]
+    start = np.zeros(nkeys + 1, dtype=np.int64)
+    for p in range(m):
+        start[keys[p] + 1] += 1
+    for k in range(nkeys):
+        start[k + 1] += start[k]
+    fill = start[:-1].copy()
+    order = np.empty(m, dtype=np.int64)
+    for p in range(m):
+        order[fill[keys[p]]] = p
+        fill[keys[p]] += 1
+    return start, order
+
+
+@njit(cache=True)
 def _reverse(n, pj):
-    m = pj.shape[0]
-    rs = np.zeros(n + 1, dtype=np.int64)
-    for p in range(m):
-        rs[pj[p] + 1] += 1
-    for i in range(n):
-        rs[i + 1] += rs[i]
-    fill = rs[:-1].copy()
-    rp = np.empty(m, dtype=np.int64)
-    for p in range(m):
-        j = pj[p]
-        rp[fill[j]] = p
-        fill[j] += 1
-    return rs, rp
+    """Reverse index of a half list: for each particle, the pairs in which it is second."""
+    return _bucket(pj, n)
 
 
 @njit(cache=True)
