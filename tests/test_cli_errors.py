@@ -33,6 +33,7 @@ CONFIGS = {
     "br_typo": "[condition]\nindex = 5\n[run]\nbogus = 1\n",
     "br_both": "[condition]\nload_kN = 13.0\npressure_Pa = 1e6\nrpm = 800.0\n",
     "br_curve": "[condition]\nindex = 5\n[thermal]\ncurve = 'no_such_curve.csv'\n",
+    "br_threads": "[condition]\nindex = 5\n[run]\nthreads = 200\n",
 }
 
 NEW = "{tmp}/new"  # an output folder that must not be created by a refused command
@@ -142,6 +143,8 @@ CASES: list[tuple[str, list[str], list[str]]] = [
      ["load_kN", "pressure_Pa"]),
     ("braking-curve", ["braking", "run", "--config", "{cfg:br_curve}", "--out", NEW],
      ["thermal.curve", "no_such_curve.csv"]),
+    ("braking-threads", ["braking", "run", "--config", "{cfg:br_threads}", "--out", NEW],
+     ["run.threads", "200"]),
     ("braking-out-file", ["braking", "run", "--condition", "5", "--quick", "--out", "{file}"],
      ["--out"]),
     ("braking-resume-empty", ["braking", "run", "--condition", "5", "--quick", "--out",

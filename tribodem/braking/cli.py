@@ -321,6 +321,7 @@ def braking_run(
         cfg = _config(condition, config, quick)
         setup_from_config(cfg)  # refuse a bad condition before any work
         runs.check_out_dir(out, "--out")
+    runs.check_threads(cfg.run.threads, "run.threads")
     runs.announce(out, ck, resume_hint="add --resume to the same command")
     if resume and rec.get("finished"):
         done = _finished_summary(out)
