@@ -186,7 +186,7 @@ class HalfSpaceSolver(FirstBodySolver):
             else:
                 window = k * _estimate_contact_radius(upper, lower, self.load, self.modulus)
         self.dx = _check_positive("window", window) / self.n
-        g0 = self.gap(0.0)
+        g0 = HalfSpaceSolver.gap(self, 0.0)  # the surfaces alone (no subclass additions)
         along_y = float(np.ptp(g0, axis=1).max())
         flat_y = along_y <= 1e-12 * max(float(np.ptp(g0)), 1e-300)
         if contact == "line" and not flat_y:
