@@ -98,6 +98,7 @@ class Simulation:
         self._wsum = np.zeros((nblocks, len(self.walls), 5))
         self._wforce = np.zeros((n, 3))
         self._wtorque = np.zeros((n, 3))
+        self._walls_now = wall_arrays(self.walls)  # refreshed at the start of every step
         self._build_wall_list()
         self.drift = np.zeros(nblocks)
         self.dt_critical, self.dt_limit_by = critical_step(
@@ -212,11 +213,10 @@ class Simulation:
         if not self.walls:
             return False
         wp0, wn0 = self._wall_ref
-        for w_id, w in enumerate(self.walls):
-            if not np.array_equal(w.normal, wn0[w_id]) or \
-                    abs(float((w.point - wp0[w_id]) @ w.normal)) > 0.5 * self.skin:
-                return True
-        return False
+        wp, wn, _, _ = self._walls_now
+        if not np.array_equal(wn, wn0):
+            return True
+        return float(np.abs(((wp - wp0) * wn).sum(axis=1)).max()) > 0.5 * self.skin
 
     def _maybe_rebuild(self) -> None:
         if self.drift.max(initial=0.0) <= 0.5 * self.skin and not self._walls_drifted():
@@ -248,7 +248,7 @@ class Simulation:
         if not self.walls:
             return
         p = self.p
-        wp, wn, wv, wm = wall_arrays(self.walls)
+        wp, wn, wv, wm = self._walls_now
         laws.active(wall_forces).pick(p.n)(
             p.pos, p.vel, p.omega, p.radius, p.mass, p.inertia, p.mat, self._wstart,
             self._wid, wp, wn, wv, wm, self.wall_hist, self.wall_info, self._wsum,
@@ -283,6 +283,8 @@ class Simulation:
             if self.step_count == 0 and self.time == 0.0:
                 self._sample(force=True)
             for _ in range(n):
+                # the walls' arrays of this step (they move only after the update)
+                self._walls_now = wall_arrays(self.walls)
                 self._maybe_rebuild()
                 self._pair_forces()
                 if self.interactions:
