@@ -52,3 +52,15 @@ def default_sigint() -> None:
     import signal
 
     signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
+#: The tiny braking cell of the braking CLI tests (same as ``test_braking.SMALL``): a TOML
+#: [geometry] table, 100 x 36 + 36 um, 4 um roughness in 2 modes, packing seed 3.
+TINY_CELL = """[geometry]
+width_m = 100e-6
+disc_height_m = 36e-6
+pad_height_m = 36e-6
+roughness_amplitude_m = 4e-6
+roughness_modes = 2
+seed = 3
+"""

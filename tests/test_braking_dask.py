@@ -16,19 +16,12 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
-from conftest import run_tribodem, tribodem_exe
+from conftest import TINY_CELL, run_tribodem, tribodem_exe
 
 pytest.importorskip("distributed")
 
-SWEEP = """
-[geometry]
-width_m = 100e-6
-disc_height_m = 36e-6
-pad_height_m = 36e-6
-roughness_amplitude_m = 4e-6
-roughness_modes = 2
-seed = 3
-
+SWEEP = f"""
+{TINY_CELL}
 [run]
 duration_s = 0.5e-6
 samples = 8

@@ -13,23 +13,16 @@ import time
 from pathlib import Path
 
 import pytest
-from conftest import default_sigint, run_tribodem, tribodem_exe
+from conftest import TINY_CELL, default_sigint, run_tribodem, tribodem_exe
 
 #: a tiny interface (~150 particles), ~17k steps per microsecond of sliding
-SMALL = """
+SMALL = f"""
 [condition]
 index = 5
 
-[geometry]
-width_m = 100e-6
-disc_height_m = 36e-6
-pad_height_m = 36e-6
-roughness_amplitude_m = 4e-6
-roughness_modes = 2
-seed = 3
-
+{TINY_CELL}
 [run]
-duration_s = {duration}
+duration_s = {{duration}}
 samples = 20
 vtk_snapshots = 3
 figures = false
@@ -197,15 +190,8 @@ def test_bad_inputs_are_refused_before_any_work(reference: tuple[Path, Path],
     assert _snapshot(out) == before
 
 
-SWEEP = """
-[geometry]
-width_m = 100e-6
-disc_height_m = 36e-6
-pad_height_m = 36e-6
-roughness_amplitude_m = 4e-6
-roughness_modes = 2
-seed = 3
-
+SWEEP = f"""
+{TINY_CELL}
 [run]
 duration_s = 0.6e-6
 samples = 8
