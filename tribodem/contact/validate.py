@@ -25,18 +25,12 @@ from typing import Any
 import numpy as np
 
 from tribodem.contact.base import ElasticBody, contact_modulus
+from tribodem.contact.checks import check
 from tribodem.contact.geometry import HertzSphere
 from tribodem.contact.halfspace import HalfSpaceSolver
 from tribodem.materials.en24t import EN24T
 
 LOAD, MU, RADIUS = 100.0, 0.6, 4e-3
-
-
-def check(name: str, value: float, reference: float, tolerance: float) -> dict[str, Any]:
-    """One check record (relative error)."""
-    err = abs(value - reference) / abs(reference)
-    return {"name": name, "value": float(value), "reference": float(reference),
-            "error": float(err), "tolerance": float(tolerance), "pass": bool(err <= tolerance)}
 
 
 def _sphere(x: np.ndarray, y: np.ndarray) -> np.ndarray:

@@ -32,20 +32,13 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import brentq
 
+from tribodem.contact.checks import check
 from tribodem.contact.fe.deck import FEMaterial
 from tribodem.contact.fe.model import LineCase, LineRun, run_line_case
 from tribodem.contact.fe.results import ContactState, ip_coordinates
 
 #: Johnson's von Mises first-yield factor of a line contact (nu = 0.3) and its depth / a
 YIELD_FACTOR, YIELD_DEPTH = 1.79, 0.70
-
-
-def check(name: str, value: float, reference: float, tolerance: float,
-          absolute: bool = False) -> dict[str, Any]:
-    """One check record; relative error unless ``absolute``."""
-    err = abs(value - reference) if absolute else abs(value - reference) / abs(reference)
-    return {"name": name, "value": float(value), "reference": float(reference),
-            "error": float(err), "tolerance": float(tolerance), "pass": bool(err <= tolerance)}
 
 
 def in_contact(state: ContactState, p0: float) -> NDArray[np.bool_]:
