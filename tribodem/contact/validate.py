@@ -26,23 +26,11 @@ import numpy as np
 
 from tribodem.contact.base import ElasticBody, contact_modulus
 from tribodem.contact.checks import check
-from tribodem.contact.geometry import HertzSphere
+from tribodem.contact.geometry import HertzSphere, cylinder, flat, sphere
 from tribodem.contact.halfspace import HalfSpaceSolver
 from tribodem.materials.en24t import EN24T
 
 LOAD, MU, RADIUS = 100.0, 0.6, 4e-3
-
-
-def _sphere(x: np.ndarray, y: np.ndarray) -> np.ndarray:
-    return (x**2 + y**2) / (2 * RADIUS)
-
-
-def _flat(x: np.ndarray, y: np.ndarray) -> np.ndarray:
-    return np.zeros(np.broadcast_shapes(np.shape(x), np.shape(y)))
-
-
-def _cylinder(x: np.ndarray, y: np.ndarray) -> np.ndarray:
-    return np.broadcast_to(x**2 / (2 * RADIUS), np.broadcast_shapes(np.shape(x), np.shape(y)))
 
 
 def halfspace_checks(n: int = 128) -> list[dict[str, Any]]:
@@ -51,7 +39,10 @@ def halfspace_checks(n: int = 128) -> list[dict[str, Any]]:
     e_star = contact_modulus(mat, mat)
     hz = HertzSphere(RADIUS, LOAD, e_star)
     out: list[dict[str, Any]] = []
-    s = HalfSpaceSolver(_sphere, _flat, load=LOAD, friction=MU, n=n)
+    # the Hertz (parabolic) profiles the closed forms are for
+    ball, plane = sphere(RADIUS, exact=False), flat()
+    roller = cylinder(2 * RADIUS, axis="y", exact=False)
+    s = HalfSpaceSolver(ball, plane, load=LOAD, friction=MU, n=n)
     inc = s.solve_increment(0.0)
     out.append(check("hertz point p0 (Pa)", inc.max_pressure, hz.peak_pressure, 0.02))
     out.append(check("hertz point a (m)", math.sqrt(inc.contact_area / math.pi),
@@ -60,7 +51,7 @@ def halfspace_checks(n: int = 128) -> list[dict[str, Any]]:
     p_line = 1e5  # N/m
     b = math.sqrt(4 * p_line * RADIUS / (math.pi * e_star))
     w = 10 * b
-    sl = HalfSpaceSolver(_cylinder, _flat, load=p_line * w, friction=MU, n=n, window=w)
+    sl = HalfSpaceSolver(roller, plane, load=p_line * w, friction=MU, n=n, window=w)
     li = sl.solve_increment(0.0)
     out.append(check("hertz line p0 (Pa)", li.max_pressure,
                      math.sqrt(p_line * e_star / (math.pi * RADIUS)), 0.02))
@@ -69,7 +60,7 @@ def halfspace_checks(n: int = 128) -> list[dict[str, Any]]:
     slope, icpt = np.polyfit(sl.coords[on] ** 2, row[on] ** 2, 1)
     out.append(check("hertz line a (m)", math.sqrt(-icpt / slope), b, 0.02))
     # Cattaneo-Mindlin partial slip (Ciavarella-Jaeger regime)
-    cj = HalfSpaceSolver(_sphere, _flat, load=LOAD, friction=MU, n=n, regime="ciavarella-jaeger")
+    cj = HalfSpaceSolver(ball, plane, load=LOAD, friction=MU, n=n, regime="ciavarella-jaeger")
     first = cj.solve_increment(0.0)
     d_star = MU * cj.kappa * cj.approach(first.pressure, cj.gap(0.0))
     for frac in (0.3, 0.5, 0.7):
@@ -89,7 +80,7 @@ def halfspace_checks(n: int = 128) -> list[dict[str, Any]]:
     out.append(check("gross slip Q / (mu P)", -float(g.traction[..., 0].sum()) * s.dx**2
                      / (MU * LOAD), 1.0, 0.01))
     # first yield (frictionless, von Mises): the load at which max sigma_vM reaches Y
-    s0 = HalfSpaceSolver(_sphere, _flat, load=LOAD, friction=0.0, n=n)
+    s0 = HalfSpaceSolver(ball, plane, load=LOAD, friction=0.0, n=n)
     i0 = s0.solve_increment(0.0)
     vm = s0.subsurface_stress(i0, "lower", depth=hz.contact_radius, nz=41).von_mises.max()
     p_y = LOAD * (EN24T.yield_strength / vm) ** 3  # sigma ~ p0 ~ P^(1/3)
