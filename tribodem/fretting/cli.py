@@ -656,6 +656,17 @@ def build_solver(cfg: FrettingConfig) -> FirstBodySolver:
         raise ConfigError(f"contact: {err}") from None
 
 
+def debris_settings(cfg: FrettingConfig) -> DebrisSettings:
+    """The debris particles of the ``[debris]`` table (``ConfigError`` if unusable); they take
+    the lower body's (the track's) material."""
+    lo = materials(cfg)[1]
+    try:
+        return DebrisSettings(young=lo.young, poisson=lo.poisson,
+                              **cfg.debris.model_dump(exclude={"every"}))
+    except ValueError as err:
+        raise ConfigError(str(err)) from None
+
+
 def build_loop(cfg: FrettingConfig) -> FrettingLoop:
     """Solver + criterion + strategy from a validated config (``ConfigError`` if unusable)."""
     check_compatible(cfg)
@@ -675,14 +686,7 @@ def build_loop(cfg: FrettingConfig) -> FrettingLoop:
             strategy = make_strategy(cfg.jump.strategy, **params)
         except (TypeError, ValueError) as err:
             raise ConfigError(f"jump.params for '{cfg.jump.strategy}': {err}") from None
-    debris = None
-    if cfg.debris.every is not None:
-        dc = cfg.debris.model_dump(exclude={"every"})
-        try:
-            lo = materials(cfg)[1]  # the debris takes the lower body's (the track's) material
-            debris = DebrisField(DebrisSettings(young=lo.young, poisson=lo.poisson, **dc))
-        except ValueError as err:
-            raise ConfigError(str(err)) from None
+    debris = DebrisField(debris_settings(cfg)) if cfg.debris.every is not None else None
     try:
         return FrettingLoop(solver, crit, amplitude=c.amplitude, n_increments=c.n_increments,
                             strategy=strategy, debris=debris,
@@ -909,3 +913,61 @@ def run_cmd(
         f"upper {summary['wear_volume_upper_m3']:.4g} m^3, lower "
         f"{summary['wear_volume_lower_m3']:.4g} m^3 -> {out}"
     )
+
+
+#: ``debris-study --quick``: the seed's counts / 20 on the quick preset (64^2, 10 cycles).
+QUICK_STUDY_COUNTS = "1100,4050,5100"
+
+
+def parse_counts(text: str, field: str = "--counts") -> tuple[int, ...]:
+    """Comma-separated particle counts (each 1..10^7, distinct, in any order)."""
+    try:
+        counts = tuple(int(v) for v in text.replace(" ", "").split(","))
+    except ValueError:
+        counts = ()
+    if not counts or any(not 1 <= c <= 10**7 for c in counts) or len(set(counts)) < len(
+            counts):
+        raise ConfigError(f"{field} = {text!r}: allowed: comma-separated distinct particle "
+                          "counts, each 1..10000000 (e.g. 22000,81000,102000)")
+    return counts
+
+
+@fretting_app.command("debris-study")
+def debris_study_cmd(
+    out: Annotated[Path, typer.Option("--out", help="Output directory.")],
+    config: Annotated[Path | None, typer.Option(
+        "--config", help="TOML config of the case (default: the energy case).")] = None,
+    counts: Annotated[str | None, typer.Option(
+        "--counts", help="Debris particle counts (default: the seed's 22000,81000,102000; "
+        f"--quick: {QUICK_STUDY_COUNTS}).")] = None,
+    cycle: Annotated[int | None, typer.Option(
+        "--cycle", help="Cycle of the study (default: config cycles, 160).")] = None,
+    threads: Annotated[int, typer.Option("--threads", help="DEM threads (0 = all).")] = 0,
+    quick: Annotated[bool, typer.Option("--quick", help="64^2 grid, cycle 10, counts / 20.")
+                     ] = False,
+    resume: Annotated[bool, typer.Option(
+        "--resume", help="Skip the finished stages of an earlier study in --out.")] = False,
+    progress: Annotated[bool, typer.Option(
+        "--progress/--no-progress", help="Progress bar of the wear run on stderr.")] = True,
+) -> None:
+    """Seed 003 section 5.4: contact force on the lower body at a cycle, without and with N
+    debris particles (figs 5.22-5.27); writes debris_study.{csv,json}, plots, per-count data."""
+    import numba
+
+    from tribodem.fretting.debris_study import SEED_COUNTS, run_debris_study
+
+    n_threads = runs.check_threads(threads, "--threads")
+    wanted = parse_counts(counts if counts is not None else (
+        QUICK_STUDY_COUNTS if quick else ",".join(str(c) for c in SEED_COUNTS)))
+    ov: dict[str, Any] = {}
+    if cycle is not None:
+        ov["cycles"] = cycle
+    runs.check_out_dir(out, "--out", resume=resume, need=("study.toml",) if resume else ())
+    base = load_toml(out / "study.toml", "--out")["config"] if resume and config is None \
+        else None
+    cfg = resolve_config(config, quick=quick, overrides=ov, base=base)
+    numba.set_num_threads(n_threads)
+    summary = run_debris_study(cfg, out, wanted, resume=resume, progress=progress,
+                               echo=typer.echo)
+    typer.echo(f"done: debris study at cycle {summary['cycle']} "
+               f"({', '.join(f'{c:,}' for c in wanted)} particles) -> {out}")
