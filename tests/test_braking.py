@@ -28,6 +28,8 @@ from tribodem.braking.model import (
     Geometry,
     build_interface,
     plate_force,
+    profile_height,
+    rough_profile,
     start_sliding,
 )
 from tribodem.braking.run import RunSetup, run_braking, wear_extrapolation
@@ -66,8 +68,24 @@ def test_interface_geometry_and_boundary_conditions() -> None:
     # pad above disc, its lowest point a clearance above the disc's highest point
     gap = (p.pos[pad, 1] - p.radius[pad]).min() - (p.pos[disc, 1] + p.radius[disc]).max()
     assert gap == pytest.approx(SMALL.clearance, abs=1e-12)
-    # rough: the outer surfaces vary by more than one particle diameter along x
-    assert np.ptp(p.pos[disc, 1][np.argsort(p.pos[disc, 1])[-10:]]) > 0
+    # rough: the disc is cut by its profile (eq: rough_profile from the geometry's seed) and
+    # its surface follows it: in each 10 um bin the highest centre lies between the lowest
+    # profile height of the bin less one particle diameter and the highest (a flat cut at
+    # the mean height would break the upper bound where the profile dips 3 um below it)
+    prof = rough_profile(np.random.default_rng(SMALL.seed + 7919), SMALL.width,
+                         SMALL.amplitude, SMALL.modes)
+    xd, yd = np.mod(p.pos[disc, 0], SMALL.width), p.pos[disc, 1]
+    y_mid = SMALL.disc_height + SMALL.amplitude
+    assert np.all(yd < y_mid + profile_height(xd, SMALL.width, prof))
+    nb, dmax = 10, 2 * p.radius.max()
+    xs = np.linspace(0.0, SMALL.width, 1001)
+    hs = y_mid + profile_height(xs, SMALL.width, prof)
+    assert np.ptp(hs) > dmax * 0.8  # the relief is a particle diameter or more
+    for k in range(nb):
+        lo, hi = k * SMALL.width / nb, (k + 1) * SMALL.width / nb
+        top = yd[(xd >= lo) & (xd < hi)].max()
+        hb = hs[(xs >= lo) & (xs <= hi)]
+        assert hb.min() - dmax <= top <= hb.max(), k
     assert np.all(p.fixed[it.anchor_disc] & (FIX_X | FIX_Y) == (FIX_X | FIX_Y))
     # absorbing backing (default): the pad's top layer is free, held by dashpots
     assert not np.any(p.fixed[it.anchor_pad] & (FIX_X | FIX_Y)) and it.backing is not None
