@@ -134,7 +134,7 @@ def test_read_dat_blocks(tmp_path: Path) -> None:
 def test_missing_ccx_names_the_install_command(tmp_path: Path,
                                                monkeypatch: pytest.MonkeyPatch) -> None:
     _, deck = build(coarse_case(), tmp_path)
-    with pytest.raises(CcxNotFoundError, match="apt-get install calculix-ccx"):
+    with pytest.raises(CcxNotFoundError, match="apt-get install -y calculix-ccx"):
         run_ccx(deck, executable="ccx-not-installed-here")
     monkeypatch.setenv("PATH", "")
     with pytest.raises(CcxNotFoundError) as exc:

@@ -29,6 +29,7 @@ from tribodem.contact.elastoplastic import (
     PlasticSubsurfaceStress,
     bilinear_hardening,
 )
+from tribodem.contact.fe.backend import FEContactSolver
 from tribodem.contact.geometry import (
     HeightMap,
     HertzSphere,
@@ -42,6 +43,7 @@ from tribodem.contact.halfspace import HalfSpaceSolver, max_shear, von_mises
 BACKENDS: dict[str, type[FirstBodySolver]] = {
     "elastic": HalfSpaceSolver,
     "elastic-plastic": ElastoPlasticSolver,
+    "fe": FEContactSolver,
 }
 
 __all__ = [

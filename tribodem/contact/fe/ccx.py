@@ -23,7 +23,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 #: the one command that installs the solver (Debian/Ubuntu package of CalculiX 2.20)
-INSTALL_COMMAND = "apt-get install calculix-ccx"
+INSTALL_COMMAND = "apt-get install -y calculix-ccx"
 
 _CONVERGENCE_WORDS = ("diverge", "cutback", "too many iterations", "increment size smaller",
                       "no convergence", "not converge")
@@ -33,7 +33,12 @@ class CcxNotFoundError(FileNotFoundError):
     """The ccx executable is not on PATH."""
 
 
-class CcxError(RuntimeError):
+class FESolverStopped(RuntimeError):
+    """The finite-element solve cannot go on (ccx failed, the mesh cannot be morphed); a
+    fretting run stops early with this message and keeps its outputs (exit 3)."""
+
+
+class CcxError(FESolverStopped):
     """ccx stopped with an error; ``message`` is ccx's own text, ``deck`` the input file."""
 
     def __init__(self, what: str, message: str, deck: Path, sta: str = "") -> None:

@@ -82,6 +82,12 @@ class ContactSettings:
     #: similar bodies, Dundurs beta = 0, the normal problem does not depend on friction)
     mu_loading: float = 1e-3
     stick_factor_loading: float = 0.1  #: stick slope factor while seating and loading
+    #: ``*CONTACT PAIR`` once in the model data (else, as validated for the Hertz and
+    #: Mindlin checks, written again with each ``*CHANGE FRICTION``)
+    pair_in_model: bool = False
+    #: node-to-surface only: the tension (Pa) ccx's linear law keeps at large clearances
+    #: (None: ccx's default, measured 0.34 % of p0 on every free slave node; docs/fe.md)
+    tension: float | None = None
 
 
 @dataclass(frozen=True)
@@ -97,6 +103,13 @@ class LoadCase:
     #: ``*CONTROLS, PARAMETERS=FIELD``: residual and correction tolerances (ccx defaults
     #: 0.005, 0.01), e.g. (0.02, 0.05) for plastic cycles; None keeps the defaults
     field_controls: tuple[float, float] | None = None
+    #: divide the largest automatic increment of the loading and the cycle by this factor,
+    #: keeping the output times (the retry after a non-convergence)
+    refine: int = 1
+    #: the cycle as one step per monotonic quarter (0 -> +d, +d -> 0, 0 -> -d, -d -> 0),
+    #: ramped boundary values instead of the ``*AMPLITUDE``: ccx 2.20's surface-to-surface
+    #: friction keeps a wrong tangential state through a reversal inside one step (docs/fe.md)
+    split_cycle: bool = False
 
 
 def _fmt(v: float) -> str:
@@ -149,9 +162,12 @@ def _model_data(out: io.StringIO, mesh: Mesh, lower: FEMaterial, upper: FEMateri
                 out.write(f"2\n{int(n)}, {dof}, 1., {ref}, {dof}, -1.\n")
     k_n = contact.penalty_factor * min(lower.young, upper.young) / mesh.h_fine
     out.write("*SURFACE INTERACTION, NAME=SI\n")
-    out.write(f"*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR\n{_fmt(k_n)}\n")
+    tension = "" if contact.tension is None else f", {_fmt(contact.tension)}"
+    out.write(f"*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR\n{_fmt(k_n)}{tension}\n")
     if contact.mu > 0:
         out.write(f"*FRICTION\n{contact.mu}, {_fmt(contact.stick_factor * k_n)}\n")
+    if contact.pair_in_model:
+        out.write(f"*CONTACT PAIR, INTERACTION=SI, TYPE={contact.formulation}\nSPAD, SFLAT\n")
 
 
 def _change_friction(out: io.StringIO, mesh: Mesh, lower: FEMaterial, upper: FEMaterial,
@@ -162,7 +178,8 @@ def _change_friction(out: io.StringIO, mesh: Mesh, lower: FEMaterial, upper: FEM
         factor = contact.stick_factor_loading if loading else contact.stick_factor
         out.write("*CHANGE FRICTION, INTERACTION=SI\n")
         out.write(f"*FRICTION\n{mu}, {_fmt(factor * k_n)}\n")
-    out.write(f"*CONTACT PAIR, INTERACTION=SI, TYPE={contact.formulation}\nSPAD, SFLAT\n")
+    if not contact.pair_in_model:
+        out.write(f"*CONTACT PAIR, INTERACTION=SI, TYPE={contact.formulation}\nSPAD, SFLAT\n")
 
 
 def _time_points(out: io.StringIO, name: str, times: np.ndarray) -> None:
@@ -214,7 +231,9 @@ def write_deck(path: str | Path, mesh: Mesh, case: LoadCase,
     total = 1.0 if case.half_cycle else 4.0
     n_tan = n // 4 if case.half_cycle else n
     _time_points(out, "TLOAD", np.arange(1, n_load + 1) / n_load)
-    if case.delta > 0:
+    if case.delta > 0 and case.split_cycle:
+        _time_points(out, "TQUARTER", np.arange(1, n // 4 + 1) / (n // 4))
+    elif case.delta > 0:
         _time_points(out, "TCYCLE", np.arange(1, n_tan + 1) * (4.0 / n))
     out.write("*BOUNDARY\nLBOT, 1, 2\n")
     controls = ""
@@ -228,15 +247,26 @@ def write_deck(path: str | Path, mesh: Mesh, case: LoadCase,
     _outputs(out, plastic, fine_stress, frd, "")
     out.write("*END STEP\n")
     # step 2: normal load P on REF (automatic increments <= 1 / n_load, output at 1 / n_load)
-    dt = 1.0 / n_load
+    refine = max(int(case.refine), 1)
+    dt = 1.0 / (n_load * refine)
     out.write(f"*STEP, INC=1000\n*STATIC\n{dt}, 1., {dt * 1e-4}, {dt}\n")
     out.write(f"*BOUNDARY, OP=NEW\nLBOT, 1, 2\n{ref}, 1, 1, 0.\n")
     out.write(f"*CLOAD\n{ref}, 2, {_fmt(-case.load)}\n" + controls)
     _outputs(out, plastic, fine_stress, frd, "TLOAD")
     out.write("*END STEP\n")
     # step 3: tangential displacement cycle (increments <= 4 / n, output every 4 / n)
-    if case.delta > 0:
-        dt = 4.0 / n
+    if case.delta > 0 and case.split_cycle:
+        targets = [case.delta, 0.0, -case.delta, 0.0][:1 if case.half_cycle else 4]
+        dt = 4.0 / (n * refine)
+        for k, target in enumerate(targets):
+            out.write(f"*STEP, INC=10000\n*STATIC\n{dt}, 1., {dt * 1e-4}, {dt}\n")
+            if k == 0:
+                _change_friction(out, mesh, lower, upper, contact, loading=False)
+            out.write(f"*BOUNDARY\n{ref}, 1, 1, {_fmt(target)}\n" + controls)
+            _outputs(out, plastic, fine_stress, frd, "TQUARTER")
+            out.write("*END STEP\n")
+    elif case.delta > 0:
+        dt = 4.0 / (n * refine)
         out.write(f"*STEP, INC=10000\n*STATIC\n{dt}, {total}, {dt * 1e-4}, {dt}\n")
         _change_friction(out, mesh, lower, upper, contact, loading=False)
         out.write(f"*BOUNDARY, AMPLITUDE=STROKE\n{ref}, 1, 1, {_fmt(case.delta)}\n" + controls)

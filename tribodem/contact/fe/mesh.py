@@ -76,6 +76,12 @@ class Mesh:
     surfaces: dict[str, tuple[NDArray[np.int64], int]] = field(default_factory=dict)
     h_fine: float = 0.0  #: element size in the fine zone, m
     info: dict[str, float] = field(default_factory=dict)  #: geometry parameters, SI
+    #: straight node columns per body (``"lower"``, ``"upper"``): 0-based node rows
+    #: [n_columns, n_layers], surface node first, going into the body; columns sorted by x
+    columns: dict[str, NDArray[np.int64]] = field(default_factory=dict)
+    #: node layers of the fine zone below the surface: column node ``fine_layers`` is the
+    #: bottom of the fine section (``H`` of seed eq 3.7), the last node morphing moves
+    fine_layers: int = 0
 
     @property
     def n_nodes(self) -> int:
@@ -192,6 +198,9 @@ def cylinder_on_flat(p: PadOnFlat) -> Mesh:
     bot_row = upper[:nxu - 1]
     flat_faces = top_row[np.abs(cen[top_row - 1, 0]) < fine_l + 8 * a]
     pad_faces = bot_row[np.abs(cen[bot_row - 1, 0]) < fine_u + 2 * a]
+    nyl, nyu = yl.size, eta.size
+    col_l = ((nyl - 1 - np.arange(nyl))[None, :] * nxl + np.arange(nxl)[:, None]).astype(np.int64)
+    col_u = (off + np.arange(nyu)[None, :] * nxu + np.arange(nxu)[:, None]).astype(np.int64)
     mesh = Mesh(
         nodes=nodes,
         elements=elements,
@@ -203,6 +212,72 @@ def cylinder_on_flat(p: PadOnFlat) -> Mesh:
         info={"radius": R, "a": a, "half_lower": half_l, "half_upper": half_u,
               "height_lower": p.size_factor * a, "height_upper": h_top, "fine_lower": fine_l,
               "fine_upper": fine_u, "fine_depth": depth},
+        columns={"lower": col_l, "upper": col_u},
+        fine_layers=int(math.ceil(depth / h - 1e-9)),
     )
     mesh.check()
     return mesh
+
+
+def surface_profile(mesh: Mesh, body: str) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """(x, y) of the surface nodes of ``body`` (``"lower"``/``"upper"``), sorted by x, m."""
+    top = mesh.columns[body][:, 0]
+    return mesh.nodes[top, 0].copy(), mesh.nodes[top, 1].copy()
+
+
+def morph_columns(mesh: Mesh, body: str, wear: NDArray[np.float64]) -> Mesh:
+    """A copy of ``mesh`` with the surface of ``body`` receded by ``wear`` (m, one value per
+    column of ``mesh.columns[body]``, >= 0) by node-column morphing (seed eqs 3.7-3.8).
+
+    Each surface node moves along its straight column, *into* the body (the flat's down, the
+    pad's up), by its worn depth dW; the nodes below it down to the bottom of the fine section
+    (``fine_layers`` nodes deeper, at distance H) are moved by eq 3.8,
+    ``y_i = y_b + m (y_i - y_b)`` with ``m = (H - dW) / H`` (eq 3.7) and ``y_b`` the fine
+    section's bottom node (fixed), so every element of the column keeps the same fraction of
+    the column's height and the mesh keeps its aspect (nothing moves sideways). The worn
+    area is then exactly :func:`worn_area` (the columns are vertical). ``ValueError`` when a
+    worn depth reaches H (the fine section would invert)."""
+    wear = np.asarray(wear, dtype=float)
+    cols = mesh.columns[body]
+    if wear.shape != (cols.shape[0],):
+        raise ValueError(f"wear has shape {wear.shape}: expected ({cols.shape[0]},), one depth "
+                         f"per column of the {body} body")
+    if np.any(wear < 0) or not np.all(np.isfinite(wear)):
+        raise ValueError("wear depths must be finite and >= 0 (m)")
+    k = mesh.fine_layers
+    nodes = mesh.nodes.copy()
+    fine = cols[:, :k + 1]  # [n_col, k + 1]: surface .. fine bottom
+    y = nodes[fine, 1]
+    yb = y[:, -1:]
+    height = np.abs(y[:, :1] - yb)  # H per column
+    if np.any(wear >= height[:, 0]):
+        j = int(np.argmax(wear / height[:, 0]))
+        raise ValueError(f"worn depth {wear[j]:.4g} m at x = {nodes[cols[j, 0], 0]:.4g} m "
+                         f"reaches the fine section's depth H = {height[j, 0]:.4g} m of the "
+                         f"{body} body: the mesh cannot be morphed further (a deeper fine zone "
+                         "is needed)")
+    m = (height - wear[:, None]) / height  # eq 3.7
+    nodes[fine, 1] = yb + m * (y - yb)  # eq 3.8
+    out = Mesh(nodes=nodes, elements=mesh.elements, node_sets=mesh.node_sets,
+               element_sets=mesh.element_sets, surfaces=mesh.surfaces, h_fine=mesh.h_fine,
+               info=dict(mesh.info), columns=mesh.columns, fine_layers=mesh.fine_layers)
+    out.check()
+    return out
+
+
+def worn_area(original: Mesh, morphed: Mesh, body: str) -> float:
+    """Area (m^2 per metre of thickness: the worn volume per unit length, m^3/m) between the
+    original and the morphed surface of ``body``: the surfaces are the polylines through the
+    surface nodes, which share their x (vertical columns), so the area is exactly the
+    trapezoidal sum of the nodal depths."""
+    x, y0 = surface_profile(original, body)
+    _, y1 = surface_profile(morphed, body)
+    d = np.abs(y1 - y0)
+    return float(np.sum(0.5 * (d[1:] + d[:-1]) * np.diff(x)))
+
+
+def element_areas(mesh: Mesh) -> NDArray[np.float64]:
+    """Signed area of every quadrilateral (shoelace), m^2 [n_elements]."""
+    p = mesh.nodes[mesh.elements]
+    x, y = p[..., 0], p[..., 1]
+    return 0.5 * np.sum(x * np.roll(y, -1, axis=1) - np.roll(x, -1, axis=1) * y, axis=1)

@@ -1,0 +1,547 @@
+"""``fe``: the CalculiX finite-element first body behind the first-body contract (docs/fe.md).
+
+A 2D plane-strain cylindrical pad on a flat (a line contact, seed 003 sections 3.2-3.3 with
+the seed's 3D crossed cylinders replaced by their plane-strain section). Mode ``fresh`` (the
+seed's way, section 3.3): every fretting cycle is one ccx job on the current worn geometry,
+starting from virgin, unloaded bodies: seating, the normal load, then the cycle
+0 -> +A -> 0 -> -A -> 0 in the loop's ``n_increments`` increments; the job runs once per
+cycle (:meth:`FEContactSolver.begin_cycle`, or the first :meth:`solve_increment` of the
+cycle) and :meth:`solve_increment` serves its stored increments, checking that the offsets
+are the job's.
+
+Worn geometry (seed eqs 3.7-3.8): the worn depth of each body is its recession (given by
+:meth:`set_surfaces`) minus its unworn recession (the one given to the constructor),
+evaluated at the x of each straight node column of the mesh; the surface node moves into its
+body by that depth and the fine-zone nodes below it are redistributed by
+:func:`tribodem.contact.fe.mesh.morph_columns`; :meth:`worn_volume` is the exact volume of the
+morphed mesh's lost material (no 0.77 correction).
+
+Fields on the contract's window (``n x n`` points, spacing ``dx``; x along the stroke, y
+along the cylinder's axis; a line contact is periodic along y, so every field is constant
+along y and ``load`` is the total on the window, P' = load / window in N/m):
+
+* FE nodal values along the pad's surface (the pad's material points: the window travels
+  with the upper body, window x = the pad node's undeformed x) are mapped to the window
+  cells by exact cell averages of their piecewise-linear interpolant (pressure and shear:
+  the window integral equals the FE nodal force sum) and by linear interpolation (slip);
+* ``traction`` is the shear traction on the **upper** body (the pad): the x component of
+  the contact force on the pad's nodes recovered from the element stresses
+  (:mod:`tribodem.contact.fe.results`) over their tributary length, as base.py states;
+* ``slip`` is the increment of relative tangential displacement of the upper surface with
+  respect to the lower one: for each pad node, its x displacement increment minus that of
+  the flat's material point under it at the start of the increment (x of the flat point =
+  the pad node's deformed x minus the flat's displacement there);
+* ``stick``: contact nodes whose slip increment is at most mu p / k_t, the largest elastic
+  displacement of the interface's stick spring (k_t the stick slope, Pa/m).
+
+So the energy density ``-traction . slip`` is the frictional work and is >= 0, and in gross
+slip ``|Q| = mu P`` (tests/test_fe_backend.py).
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+import tempfile
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from tribodem.contact.base import (
+    Capabilities,
+    ElasticBody,
+    FirstBodySolver,
+    IncrementResult,
+    Recession,
+    WindowTooSmallError,
+    _check_positive,
+    contact_modulus,
+    cycle_offsets,
+)
+from tribodem.contact.fe.ccx import (
+    CcxConvergenceError,
+    CcxRun,
+    FESolverStopped,
+    find_ccx,
+    run_ccx,
+)
+from tribodem.contact.fe.deck import ContactSettings, FEMaterial, LoadCase, write_deck
+from tribodem.contact.fe.mesh import Mesh, PadOnFlat, cylinder_on_flat, hertz_line, morph_columns
+from tribodem.contact.fe.mesh import worn_area as mesh_worn_area
+from tribodem.contact.fe.model import DEFAULT_H_OVER_A
+from tribodem.contact.fe.results import FEResults, read_results
+from tribodem.contact.geometry import cylinder, flat, line_window
+
+#: modes of :class:`FEContactSolver` (``chained`` is not implemented yet: docs/fe.md)
+MODES = ("fresh",)
+
+
+def _second_difference(f: Recession, h: float) -> float:
+    """d^2 f / dx^2 at the origin (y = 0) by central differences of step ``h`` (m), 1/m."""
+    x = np.array([-h, 0.0, h])
+    v = np.asarray(f(x, np.zeros(3)), dtype=float)
+    return float((v[0] - 2.0 * v[1] + v[2]) / (h * h))
+
+
+def cell_average(xn: NDArray[np.float64], vn: NDArray[np.float64],
+                 centres: NDArray[np.float64], dx: float) -> NDArray[np.float64]:
+    """Averages over the cells ``[c - dx/2, c + dx/2]`` of the piecewise-linear interpolant
+    of nodal values ``vn`` at sorted ``xn`` (zero outside ``[xn[0], xn[-1]]``): exact, so the
+    cell sum times ``dx`` equals the interpolant's integral over the cells."""
+    seg = np.diff(xn)
+    cum = np.concatenate([[0.0], np.cumsum(0.5 * (vn[1:] + vn[:-1]) * seg)])
+
+    def prim(x: NDArray[np.float64]) -> NDArray[np.float64]:
+        xc = np.clip(x, xn[0], xn[-1])
+        j = np.clip(np.searchsorted(xn, xc, side="right") - 1, 0, xn.size - 2)
+        t = xc - xn[j]
+        slope = (vn[j + 1] - vn[j]) / seg[j]
+        return cum[j] + vn[j] * t + 0.5 * slope * t * t
+
+    return (prim(centres + 0.5 * dx) - prim(centres - 0.5 * dx)) / dx
+
+
+@dataclass
+class JobRecord:
+    """One ccx job of the backend: where, what it cost (s) and what it gave."""
+
+    cycle: int  #: the fretting cycle it serves (1-based)
+    folder: Path
+    deck: Path
+    elements: int
+    refine: int  #: increment refinement of the successful attempt (1: none)
+    seconds_mesh: float  #: meshing, morphing and deck writing, s
+    seconds_ccx: float  #: ccx wall clock (all attempts), s
+    seconds_read: float  #: reading the .dat and recovering the tractions, s
+    seconds_map: float = 0.0  #: mapping the fields to the window, s
+    worn_area_upper: float = 0.0  #: worn area of the morphed pad, m^2 per m
+    worn_area_lower: float = 0.0  #: worn area of the morphed flat, m^2 per m
+
+
+class FEContactSolver(FirstBodySolver):
+    """Plane-strain CalculiX cylinder-on-flat first body (see the module docstring).
+
+    ``upper``/``lower``: recessions (m) of a cylinder with its axis along y and of a flat
+    (default: R = 4 mm); the pad radius R is read from the summed recession's curvature at
+    the origin. ``load``: total normal load on the window, N (P' = load / window, N/m);
+    ``friction``: Coulomb mu; ``n``, ``window`` (m; None: ``window_radii`` Hertz
+    half-widths); ``amplitude`` (m) and ``n_increments`` of the loop's cycle (the job's
+    output times); ``h_over_a`` (element size at the contact / Hertz half-width) and
+    ``size_factor`` (bodies' size / a) of the mesh (defaults from the convergence study in
+    docs/fe.md); ``threads``, ``timeout`` (s per ccx job), ``retries`` (after a
+    non-convergence, each retry halves the largest increment); ``workdir``: the folder of the
+    jobs (``cycle_0001/`` ...; None: a new temporary folder). ``regime`` and ``tolerance``
+    are the half-space's options and are not used (the FE interface always has partial slip
+    and its own Newton tolerances).
+    """
+
+    capabilities = Capabilities(partial_slip=True, subsurface=False, contacts=("line",))
+
+    def __init__(
+        self,
+        upper: Recession | None = None,
+        lower: Recession | None = None,
+        load: float | None = None,
+        friction: float = 0.6,
+        upper_material: ElasticBody | None = None,
+        lower_material: ElasticBody | None = None,
+        n: int = 64,
+        window: float | None = None,
+        window_radii: float = 10.0,
+        contact: str = "line",
+        amplitude: float = 0.1e-3,
+        n_increments: int = 16,
+        mode: str = "fresh",
+        h_over_a: float = DEFAULT_H_OVER_A,
+        size_factor: float = 40.0,
+        threads: int = 1,
+        timeout: float = 900.0,
+        retries: int = 1,
+        workdir: str | Path | None = None,
+        executable: str = "ccx",
+        regime: str = "gross",
+        tolerance: float | None = None,
+    ) -> None:
+        del regime, tolerance  # half-space options (see the class docstring)
+        if (upper is None) != (lower is None):
+            raise ValueError("upper and lower must both be given or both be None (defaults)")
+        if upper is None or lower is None:
+            upper, lower = cylinder(8e-3, axis="y"), flat()
+        if contact != "line":
+            raise ValueError(f"contact = {contact!r} is not allowed: the fe backend solves a "
+                             "line contact only (2D plane strain); allowed: 'line'")
+        if mode not in MODES:
+            raise ValueError(f"mode = {mode!r} is not allowed: allowed: {', '.join(MODES)}")
+        self.mode = mode
+        self.executable = find_ccx(executable)  # CcxNotFoundError names the install command
+        self.upper, self.lower = upper, lower
+        self._base_upper, self._base_lower = upper, lower
+        self.friction = _check_positive("friction", friction, allow_zero=True)
+        self.upper_material = upper_material or ElasticBody()
+        self.lower_material = lower_material or ElasticBody()
+        self.modulus = contact_modulus(self.upper_material, self.lower_material)
+        if int(n) != n or n < 16 or n % 2:
+            raise ValueError(f"n = {n!r} is not allowed: must be an even integer >= 16")
+        self.n = int(n)
+        self.contact = "line"
+        # geometry: a cylinder (axis along y) on a flat
+        h = 10e-6
+        k_up, k_lo = _second_difference(upper, h), _second_difference(lower, h)
+        if not k_up > 0:
+            raise ValueError(f"the upper body's recession has no positive curvature along x "
+                             f"({k_up:.3g} 1/m): the fe backend models a cylinder on a flat")
+        if abs(k_lo) > 1e-6 * k_up:
+            raise ValueError(f"the lower body's recession is curved along x ({k_lo:.3g} 1/m): "
+                             "the fe backend models a cylinder on a flat")
+        ys = np.array([-1e-3, 0.0, 1e-3])
+        for name, f in (("upper", upper), ("lower", lower)):
+            v = np.asarray(f(np.full(3, 50e-6), ys), dtype=float)
+            if float(np.ptp(v)) > 1e-12 * max(abs(float(v[1])), 1e-9):
+                raise ValueError(f"the {name} body's recession depends on y: a line contact's "
+                                 "surfaces must not (cylinder axis along y)")
+        self.radius = 1.0 / k_up
+        if load is None:
+            load = 1e5 * (window if window is not None else 1e-3)
+        self.load = _check_positive("load", load)
+        if window is None:
+            window = line_window(self.radius, self.load,
+                                 self.modulus, _check_positive("window_radii", window_radii))
+        self.dx = _check_positive("window", window) / self.n
+        self.amplitude = _check_positive("amplitude", amplitude)
+        self.offsets = cycle_offsets(self.amplitude, n_increments)
+        self.n_increments = int(n_increments)
+        self.h_over_a = _check_positive("h_over_a", h_over_a)
+        self.size_factor = _check_positive("size_factor", size_factor)
+        if int(threads) != threads or threads < 1:
+            raise ValueError(f"threads = {threads!r} is not allowed: an integer >= 1")
+        self.threads = int(threads)
+        self.timeout = _check_positive("timeout", timeout)
+        if int(retries) != retries or retries < 0:
+            raise ValueError(f"retries = {retries!r} is not allowed: an integer >= 0")
+        self.retries = int(retries)
+        self.workdir: Path | None = None if workdir is None else Path(workdir)
+        #: node-to-surface contact, the pair declared once (docs/fe.md, "Reversals": ccx
+        #: 2.20's surface-to-surface friction loses 30-40 % of mu P on the return strokes)
+        self.settings = ContactSettings(mu=self.friction, formulation="NODE TO SURFACE",
+                                        pair_in_model=True, tension=1e-5 * self.hertz[0])
+        self.jobs: list[JobRecord] = []  #: every ccx job run, in order
+        self._mesh0 = self._base_mesh()
+        self.reset()
+        self._cycle = 0  # cycles served (the job folder's number is the next one)
+        self._job_key: tuple[bytes, bytes] | None = None
+        self._served: list[IncrementResult] = []
+        self._loaded_result: IncrementResult | None = None
+        self.mesh: Mesh = self._mesh0  #: the (morphed) mesh of the last job
+
+    # -- geometry -------------------------------------------------------------------------
+    @property
+    def load_per_length(self) -> float:
+        """P' = load / window, N/m."""
+        return self.load / self.window
+
+    @property
+    def hertz(self) -> tuple[float, float]:
+        """Hertz (p0 Pa, a m) of the unworn line contact (Johnson eq 4.45)."""
+        return hertz_line(self.load_per_length, self.radius, self.modulus)
+
+    def _materials(self) -> tuple[FEMaterial, FEMaterial]:
+        lo, up = self.lower_material, self.upper_material
+        return FEMaterial(lo.young, lo.poisson), FEMaterial(up.young, up.poisson)
+
+    def _base_mesh(self) -> Mesh:
+        a = self.hertz[1]
+        return cylinder_on_flat(PadOnFlat(radius=self.radius, a=a, h_fine=self.h_over_a * a,
+                                          stroke=self.amplitude, size_factor=self.size_factor))
+
+    def column_wear(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Worn depth (m, >= 0) at each node column of the (upper, lower) mesh: the current
+        recession minus the unworn one at the column's x (pad frame for the upper body, lab
+        frame for the lower one), y = 0."""
+        out = []
+        for body, now, base in (("upper", self.upper, self._base_upper),
+                                ("lower", self.lower, self._base_lower)):
+            x = self._mesh0.nodes[self._mesh0.columns[body][:, 0], 0]
+            y = np.zeros_like(x)
+            w = np.asarray(now(x, y), dtype=float) - np.asarray(base(x, y), dtype=float)
+            out.append(np.maximum(w, 0.0))
+        return out[0], out[1]
+
+    def morphed_mesh(self) -> Mesh:
+        """The unworn mesh with both surfaces receded by :meth:`column_wear` (eqs 3.7-3.8)."""
+        wu, wl = self.column_wear()
+        try:
+            m = morph_columns(self._mesh0, "upper", wu) if wu.any() else self._mesh0
+            return morph_columns(m, "lower", wl) if wl.any() else m
+        except ValueError as err:
+            raise FESolverStopped(f"mesh morphing: {err}") from None
+
+    def worn_volume(self, body: str, mesh: Mesh | None = None) -> float:
+        """Worn volume of ``body`` on the window's length, m^3: the exact area between the
+        unworn and the morphed surface of ``mesh`` (default: the last job's) times the
+        window side along the cylinder's axis."""
+        mesh = self.mesh if mesh is None else mesh
+        return mesh_worn_area(self._mesh0, mesh, body) * self.window
+
+    def _seat(self, mesh: Mesh) -> float:
+        """Seating displacement, m: the smallest rigid gap between the (worn) surfaces plus
+        5 % of a^2 / (2 R) (the unworn contact: 5 %, as in :mod:`.deck`)."""
+        a = self.hertz[1]
+        xu, yu = mesh.nodes[mesh.columns["upper"][:, 0]].T
+        xl, yl = mesh.nodes[mesh.columns["lower"][:, 0]].T
+        order = np.argsort(xl)
+        gap = yu - np.interp(xu, xl[order], yl[order])
+        return float(gap.min()) + 0.05 * a * a / (2.0 * self.radius)
+
+    # -- the contract ---------------------------------------------------------------------
+    def reset(self) -> None:
+        """Forget the load history: the next ``solve_increment(0.0)`` is a first loading."""
+        self._k: int | None = None  # next increment of the cycle in progress (None: none)
+        self._loaded = False
+
+    def begin_cycle(self) -> None:
+        """Run this cycle's ccx job on the current surfaces (unless the last job was on the
+        same geometry and has served only the first loading)."""
+        self._start_cycle()
+
+    def _start_cycle(self) -> None:
+        key = self._key()
+        if not (key == self._job_key and self._served and self._fresh_for_cycle):
+            self._run_job()
+        self._fresh_for_cycle = False
+        self._cycle += 1
+        self._k = 0
+
+    def _key(self) -> tuple[bytes, bytes]:
+        wu, wl = self.column_wear()
+        return wu.tobytes(), wl.tobytes()
+
+    def solve_increment(self, offset: float) -> IncrementResult:
+        """Serve the stored increment ending at ``offset`` (m): ``0.0`` after :meth:`reset`
+        is the normal loading; then the cycle's offsets in order (:func:`cycle_offsets` of
+        ``amplitude``, ``n_increments``); anything else is a ``ValueError``."""
+        offset = float(offset)
+        if self._k is None:
+            if offset == 0.0 and not self._loaded:
+                key = self._key()
+                if key != self._job_key or not self._served:
+                    self._run_job()
+                self._fresh_for_cycle = True  # the first cycle may reuse this job
+                self._loaded = True
+                assert self._loaded_result is not None
+                return self._loaded_result
+            self._start_cycle()
+        assert self._k is not None
+        expected = float(self.offsets[self._k])
+        if abs(offset - expected) > 1e-9 * self.amplitude:
+            raise ValueError(
+                f"offset = {offset!r} m is not increment {self._k + 1} of the fe job's cycle "
+                f"(expected {expected!r} m: amplitude {self.amplitude:g} m, n_increments "
+                f"{self.n_increments}); the fe backend serves the cycle 0 -> +A -> 0 -> -A -> 0"
+                " in order")
+        inc = self._served[self._k]
+        self._k += 1
+        self._loaded = True
+        if self._k == len(self.offsets):
+            self._k = None
+        return inc
+
+    # -- the job ---------------------------------------------------------------------------
+    _fresh_for_cycle = False
+
+    def _folder(self) -> Path:
+        if self.workdir is None:
+            self.workdir = Path(tempfile.mkdtemp(prefix="tribodem-fe-"))
+        return self.workdir / f"cycle_{self._cycle + 1:04d}"
+
+    def _run_job(self) -> None:
+        """Mesh, morph, write, run (retrying with smaller increments) and read one job."""
+        t0 = time.perf_counter()
+        folder = self._folder()
+        folder.mkdir(parents=True, exist_ok=True)
+        mesh = self.morphed_mesh()
+        lower, upper = self._materials()
+        seat = self._seat(mesh)
+        t_mesh = time.perf_counter() - t0
+        t_ccx = 0.0
+        run: CcxRun | None = None
+        refine = 1
+        for attempt in range(self.retries + 1):
+            refine = 2**attempt
+            t1 = time.perf_counter()
+            case = LoadCase(load=self.load_per_length, delta=self.amplitude,
+                            n_increments=self.n_increments, seat=seat, refine=refine,
+                            split_cycle=True)
+            name = "job" if refine == 1 else f"job_refine{refine}"
+            deck = write_deck(folder / f"{name}.inp", mesh, case, lower, upper, self.settings,
+                              fine_stress=False)
+            t_mesh += time.perf_counter() - t1
+            t2 = time.perf_counter()
+            try:
+                run = run_ccx(deck, threads=self.threads, timeout=self.timeout,
+                              executable=self.executable)
+            except CcxConvergenceError:
+                t_ccx += time.perf_counter() - t2
+                if attempt == self.retries:
+                    raise
+                continue
+            t_ccx += time.perf_counter() - t2
+            break
+        assert run is not None
+        t3 = time.perf_counter()
+        res = read_results(run.job, mesh)
+        t_read = time.perf_counter() - t3
+        rec = JobRecord(cycle=self._cycle + 1, folder=folder, deck=run.job.with_suffix(".inp"),
+                        elements=mesh.n_elements, refine=refine, seconds_mesh=t_mesh,
+                        seconds_ccx=t_ccx, seconds_read=t_read,
+                        worn_area_upper=mesh_worn_area(self._mesh0, mesh, "upper"),
+                        worn_area_lower=mesh_worn_area(self._mesh0, mesh, "lower"))
+        t4 = time.perf_counter()
+        self._serve(res, mesh)
+        rec.seconds_map = time.perf_counter() - t4
+        self.mesh = mesh
+        self.results = res  #: the parsed results of the last job
+        self._job_key = self._key()
+        self.jobs.append(rec)
+        self._write_profile(rec)
+
+    def _write_profile(self, rec: JobRecord) -> None:
+        assert self.workdir is not None
+        path = self.workdir / "jobs.csv"
+        row = {"cycle": rec.cycle, "elements": rec.elements, "refine": rec.refine,
+               "seconds_mesh": f"{rec.seconds_mesh:.4f}", "seconds_ccx": f"{rec.seconds_ccx:.3f}",
+               "seconds_read": f"{rec.seconds_read:.4f}", "seconds_map": f"{rec.seconds_map:.4f}",
+               "worn_volume_upper_m3": f"{rec.worn_area_upper * self.window:.9e}",
+               "worn_volume_lower_m3": f"{rec.worn_area_lower * self.window:.9e}",
+               "deck": str(rec.deck)}
+        new = not path.exists()
+        with open(path, "a", newline="") as fh:
+            w = csv.DictWriter(fh, fieldnames=list(row))
+            if new:
+                w.writeheader()
+            w.writerow(row)
+
+    def _times(self, res: FEResults) -> list[int]:
+        """Indices of the loaded state (total time 2) and of the cycle's n increments."""
+        want = np.concatenate([[2.0], 2.0 + 4.0 * np.arange(1, self.n_increments + 1)
+                               / self.n_increments])
+        idx = []
+        for t in want:
+            k = int(np.argmin(np.abs(res.times - t)))
+            if abs(res.times[k] - t) > 1e-6:
+                raise FESolverStopped(f"ccx output has no result at total time {t:g} (deck "
+                                      f"{self.jobs[-1].deck if self.jobs else '?'})")
+            idx.append(k)
+        return idx
+
+    def _serve(self, res: FEResults, mesh: Mesh) -> None:
+        """Map the job's surface fields to the window: the loaded state and the increments."""
+        idx = self._times(res)
+        c = self.coords
+        dx = self.dx
+        n = self.n
+        ubot = mesh.node_sets["UBOT"]
+        ltop = mesh.node_sets["LTOP"]
+        xu0 = mesh.nodes[ubot - 1, 0]
+        ou = np.argsort(xu0)
+        ubot, xu0 = ubot[ou], xu0[ou]
+        xl0 = mesh.nodes[ltop - 1, 0]
+        ol = np.argsort(xl0)
+        ltop, xl0 = ltop[ol], xl0[ol]
+        disp = {(b.set_name, b.time): b.rows for b in res.dat if b.kind == "displacements"}
+
+        def ux(set_name: str, ids: NDArray[np.int64], t: float) -> NDArray[np.float64]:
+            rows = disp[(set_name, t)]
+            lookup = {int(k): j for j, k in enumerate(rows[:, 0])}
+            return np.array([rows[lookup[int(k)], 1] for k in ids])
+
+        k_t = self.settings.stick_factor * self.settings.penalty_factor * min(
+            self.upper_material.young, self.lower_material.young) / mesh.h_fine
+        cell = dx * dx
+        out: list[IncrementResult] = []
+        prev_t = float(res.times[idx[0]])
+        for j, k in enumerate(idx):
+            st = res.contact[k]
+            t = float(res.times[k])
+            # recovered nodal tractions carry round-off of the 7 printed digits (~1e-7 p0):
+            # nodes below 1e-5 of the peak pressure are out of contact
+            p_node = np.where(st.pressure > 1e-5 * st.pressure.max(), st.pressure, 0.0)
+            q_node = np.where(p_node > 0.0, st.shear, 0.0)
+            p = cell_average(xu0, p_node, c, dx)
+            q = cell_average(xu0, q_node, c, dx)
+            contact_x = p > 0.0
+            if p[0] > 0.0 or p[-1] > 0.0:
+                raise WindowTooSmallError(
+                    f"the FE contact reaches the window edge (window {self.window:.4g} m, n "
+                    f"{n}): enlarge contact.window")
+            if j == 0:
+                slip_x = np.zeros(n)
+                q = np.zeros(n)  # the loading: no sliding (friction 0.001 while loading)
+                stick = None
+                start, off, direction = 0.0, 0.0, 0.0
+            else:
+                u_up0, u_up1 = ux("UBOT", ubot, prev_t), ux("UBOT", ubot, t)
+                u_lo0_all, u_lo1_all = ux("LTOP", ltop, prev_t), ux("LTOP", ltop, t)
+                x_flat = xu0 + u_up0 - np.interp(xu0 + u_up0, xl0, u_lo0_all)
+                du_lo = np.interp(x_flat, xl0, u_lo1_all) - np.interp(x_flat, xl0, u_lo0_all)
+                s_node = (u_up1 - u_up0) - du_lo
+                s_node = np.where(p_node > 0.0, s_node, 0.0)
+                slip_x = np.where(contact_x, np.interp(c, xu0, s_node), 0.0)
+                stick_node = (p_node > 0.0) & (np.abs(s_node) <= self.friction * p_node / k_t)
+                stick = np.interp(c, xu0, stick_node.astype(float)) > 0.5
+                stick = np.repeat((stick & contact_x)[:, None], n, axis=1)
+                off = float(self.offsets[j - 1])
+                start = float(self.offsets[j - 2]) if j >= 2 else 0.0
+                direction = math.copysign(1.0, off - start)
+            prev_t = t
+            p2 = np.repeat(p[:, None], n, axis=1)
+            traction = np.zeros((n, n, 2))
+            traction[..., 0] = q[:, None]
+            slip = np.zeros((n, n, 2))
+            slip[..., 0] = slip_x[:, None]
+            out.append(IncrementResult(
+                offset=off, start_offset=start, direction=direction, pressure=p2,
+                traction=traction, slip=slip, contact_area=float(contact_x.sum()) * n * cell,
+                normal_load=float(p2.sum()) * cell, stick=stick))
+        self._loaded_result = out[0]
+        self._served = out[1:]
+
+    # -- resume ---------------------------------------------------------------------------
+    def state_dict(self) -> dict[str, Any]:
+        """Between cycles a fresh-mode solver holds no load history (every cycle is a new job
+        on virgin bodies): the cycle counter, whether the bodies were loaded, and the work
+        folder. The surfaces are set by their owner."""
+        return {"cycle": self._cycle, "loaded": self._loaded, "mode": self.mode,
+                "workdir": None if self.workdir is None else str(self.workdir)}
+
+    def load_state_dict(self, state: dict[str, Any]) -> None:
+        """Restore :meth:`state_dict` (the next cycle runs its own job)."""
+        if state.get("mode", "fresh") != self.mode:
+            raise ValueError(f"saved fe mode {state.get('mode')!r}, this solver {self.mode!r}")
+        self._cycle = int(state["cycle"])
+        self._loaded = bool(state["loaded"])
+        self._k = None
+        self._job_key = None
+        self._served = []
+        if self.workdir is None and state.get("workdir"):
+            self.workdir = Path(state["workdir"])
+
+    def profile(self) -> dict[str, float]:
+        """Seconds spent per job, averaged over the jobs run: meshing (with morphing and the
+        deck), ccx, reading, mapping to the window; and the number of jobs."""
+        if not self.jobs:
+            return {"jobs": 0}
+        keys = ("seconds_mesh", "seconds_ccx", "seconds_read", "seconds_map")
+        return {"jobs": len(self.jobs),
+                **{k: float(np.mean([getattr(j, k) for j in self.jobs])) for k in keys}}
+
+    def write_json(self, path: str | Path) -> Path:
+        """The jobs' records as JSON (for a run folder)."""
+        path = Path(path)
+        path.write_text(json.dumps([{**vars(j), "folder": str(j.folder), "deck": str(j.deck)}
+                                    for j in self.jobs], indent=1))
+        return path
