@@ -53,6 +53,7 @@ __all__ = [
     "Capabilities",
     "ElasticBody",
     "ElastoPlasticSolver",
+    "FEContactSolver",
     "FirstBodySolver",
     "HalfSpaceSolver",
     "HeightMap",

@@ -21,9 +21,11 @@ from tribodem.contact import (
     BACKENDS,
     CAPABILITY_TEXT,
     ElasticBody,
+    FEContactSolver,
     FirstBodySolver,
     contact_modulus,
 )
+from tribodem.contact.fe.ccx import CcxNotFoundError
 from tribodem.contact.geometry import (
     CrossedCylinders,
     CylinderOnFlat,
@@ -285,6 +287,20 @@ class OutputConfig(_Model):
         "cycles (and at the end)")
 
 
+class FEConfig(_Model):
+    """``solver = "fe"``: the CalculiX plane-strain backend (docs/fe.md)."""
+
+    mode: Literal["fresh"] = Field("fresh", description="fresh: one ccx job per cycle on the "
+                                   "worn geometry, virgin material (seed 003 section 3.3)")
+    h_over_a: float = Field(0.125, gt=0, le=1, description="element size at the contact / "
+                            "Hertz half-width")
+    size_factor: float = Field(40.0, ge=10, le=200, description="bodies' size / half-width")
+    threads: int = Field(1, ge=0, description="ccx threads (0 = all cores; --threads)")
+    timeout: float = Field(1800.0, gt=0, description="wall-clock limit of one ccx job, s")
+    retries: int = Field(1, ge=0, le=4, description="retries after a non-convergence, each "
+                         "with half the largest increment")
+
+
 class FrettingConfig(_Model):
     """``tribodem fretting run`` configuration (TOML tables contact, wear, jump, output)."""
 
@@ -294,6 +310,7 @@ class FrettingConfig(_Model):
     wear: WearConfig = Field(default_factory=WearConfig)
     jump: JumpConfig = Field(default_factory=JumpConfig)
     plastic: PlasticConfig = Field(default_factory=PlasticConfig)
+    fe: FEConfig = Field(default_factory=FEConfig)
     debris: DebrisConfig = Field(default_factory=DebrisConfig)
     output: OutputConfig = Field(default_factory=OutputConfig)
 
@@ -617,6 +634,9 @@ def check_compatible(cfg: FrettingConfig) -> None:
                 f"debris.every = {cfg.debris.every!r}: the debris third body is not available "
                 "for contact.geometry = 'cylinder_on_flat' (a line contact); allowed: leave "
                 "debris.every out (or --no-debris)")
+    elif cfg.contact.geometry != "height_map":
+        needs.append((f"contact.geometry = {cfg.contact.geometry!r} (a point contact)",
+                      frozenset({"point_contact"})))
     if cfg.cycles > 1 and crit.requires_over_cycles:
         needs.append((f"wear.criterion = {cfg.wear.criterion!r} over cycles = {cfg.cycles} "
                       "(allowed with this solver: cycles = 1)", crit.requires_over_cycles))
@@ -650,8 +670,15 @@ def build_solver(cfg: FrettingConfig) -> FirstBodySolver:
         kw |= cfg.plastic.model_dump()
     if "line" in backend.capabilities.contacts and not isinstance(geo, HeightMaps):
         kw["contact"] = geo.contact
+    if backend is FEContactSolver:
+        fe = cfg.fe.model_dump()
+        fe["threads"] = runs.check_threads(fe["threads"], "fe.threads (--threads)")
+        kw |= fe | {"amplitude": c.amplitude, "n_increments": c.n_increments}
     try:
         return backend(upper, lower, **kw)
+    except CcxNotFoundError as err:
+        raise ConfigError(f"solver = {cfg.solver!r}: {err}; allowed: another solver "
+                          f"({', '.join(k for k in BACKENDS if k != cfg.solver)})") from None
     except ValueError as err:
         raise ConfigError(f"contact: {err}") from None
 
@@ -737,7 +764,7 @@ def _jsonable(cfg: FrettingConfig) -> dict[str, Any]:
 
 #: Config fields a resumed run may change: ``cycles`` (raised, to extend a run) and the
 #: ``[output]`` table (what is written, not the numbers).
-RESUME_MAY_CHANGE = ("cycles", "output.")
+RESUME_MAY_CHANGE = ("cycles", "output.", "fe.threads", "fe.timeout")
 
 
 def check_resume(cfg: FrettingConfig, meta: dict[str, Any], path: Path) -> None:
@@ -781,6 +808,8 @@ def run_fretting(cfg: FrettingConfig, out: Path, echo: Any = None, resume: bool 
         meta, state = checkpoint if checkpoint is not None else read_checkpoint(ck)
         check_resume(cfg, meta, ck)
     loop = build_loop(cfg)
+    if isinstance(loop.solver, FEContactSolver):  # ccx decks, logs and results kept here
+        loop.solver.workdir = out / "fe"
     if state is not None:
         try:
             loop.load_state_dict(state)
@@ -841,8 +870,10 @@ def run_fretting(cfg: FrettingConfig, out: Path, echo: Any = None, resume: bool 
     }
     summary = write_results(hist, out, extra)
     if hist.stopped:
-        runs.announce(out, ck, resume_hint="a resume would stop at the same cycle: to go on, "
-                      "start a new run with a larger contact.window")
+        fe_stop = isinstance(loop.solver, FEContactSolver) and "window" not in hist.stopped
+        runs.announce(out, ck, resume_hint="see the deck and its .log, then add --resume to "
+                      "retry the cycle" if fe_stop else "a resume would stop at the same cycle:"
+                      " to go on, start a new run with a larger contact.window")
         raise runs.RunStopped(f"{hist.stopped} (results.csv, summary.json and figures up "
                               f"to cycle {loop.cycles_done} are written)")
     return summary
@@ -868,6 +899,8 @@ def run_cmd(
         "--jump", help=f"none or one of: {', '.join(STRATEGIES)}.")] = None,
     solver: Annotated[str | None, typer.Option(
         "--solver", help=f"First-body backend: {', '.join(BACKENDS)}.")] = None,
+    threads: Annotated[int | None, typer.Option(
+        "--threads", help="ccx threads of solver = 'fe' (0 = all cores).")] = None,
     debris_every: Annotated[int | None, typer.Option(
         "--debris-every", help="Debris third body: a DE phase every K cycles.")] = None,
     no_debris: Annotated[bool, typer.Option(
@@ -895,6 +928,9 @@ def run_cmd(
         ov.setdefault("jump", {})["strategy"] = jump
     if solver is not None:
         ov["solver"] = solver
+    if threads is not None:
+        runs.check_threads(threads, "--threads")
+        ov.setdefault("fe", {})["threads"] = threads
     if debris_every is not None and no_debris:
         raise ConfigError("--debris-every and --no-debris: give one of them, not both")
     if debris_every is not None:

@@ -26,6 +26,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from tribodem.contact.base import FirstBodySolver, WindowTooSmallError, cycle_offsets, require
+from tribodem.contact.fe.ccx import FESolverStopped
 from tribodem.contact.geometry import HeightMap, Recession
 from tribodem.cyclejump import JumpStrategy
 from tribodem.fretting.criteria import Criterion, CriterionUnavailable, TrackGrid
@@ -487,7 +488,7 @@ class FrettingLoop:
             self._apply_geometry()
             try:
                 first = self.solver.solve_increment(0.0)  # normal loading at offset 0
-            except WindowTooSmallError as err:
+            except (WindowTooSmallError, FESolverStopped) as err:
                 self.history.stopped = f"first loading: {err}"
                 return self._finish(t0)
             self._p_load = first.pressure + self.solver.debris_pressure
@@ -505,7 +506,7 @@ class FrettingLoop:
         while c < cycles:
             try:
                 per = self.simulate_cycle()
-            except WindowTooSmallError as err:
+            except (WindowTooSmallError, FESolverStopped) as err:
                 hist.stopped = f"cycle {c + 1}: {err}"
                 break
             c += 1

@@ -261,13 +261,20 @@ class FEContactSolver(FirstBodySolver):
     def column_wear(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Worn depth (m, >= 0) at each node column of the (upper, lower) mesh: the current
         recession minus the unworn one at the column's x (pad frame for the upper body, lab
-        frame for the lower one), y = 0."""
+        frame for the lower one), y = 0; zero outside the window (upper) and outside the
+        window plus the stroke (lower), where the surfaces are not given."""
         out = []
-        for body, now, base in (("upper", self.upper, self._base_upper),
-                                ("lower", self.lower, self._base_lower)):
+        c = self.coords
+        pad = (math.ceil(self.amplitude / self.dx) + 1) * self.dx  # the loop's track grid
+        for body, now, base, lo, hi in (
+                ("upper", self.upper, self._base_upper, c[0], c[-1]),
+                ("lower", self.lower, self._base_lower, c[0] - pad, c[-1] + pad)):
             x = self._mesh0.nodes[self._mesh0.columns[body][:, 0], 0]
-            y = np.zeros_like(x)
-            w = np.asarray(now(x, y), dtype=float) - np.asarray(base(x, y), dtype=float)
+            inside = (x >= lo) & (x <= hi)  # the surfaces are given on the window / track
+            w = np.zeros_like(x)
+            xi, yi = x[inside], np.zeros(int(inside.sum()))
+            w[inside] = np.asarray(now(xi, yi), dtype=float) - np.asarray(base(xi, yi),
+                                                                          dtype=float)
             out.append(np.maximum(w, 0.0))
         return out[0], out[1]
 
