@@ -248,6 +248,46 @@ def contact_response(law, prop, n0, n1, n2, delta, v0, v1, v2, w0, w1, w2, rstar
     return (fn * n0 + ft0, fn * n1 + ft1, fn * n2 + ft2, r0, r1, r2, fn, energy, kn)
 
 
+@njit(cache=True, inline="always")
+def _pair(d0, d1, d2, dist, ri, rj, vi0, vi1, vi2, vj0, vj1, vj2, wi0, wi1, wi2, wj0, wj1, wj2, mi,
+          mj, ii, ij, prop, ei, ej, dim, thickness, hist, dt):
+    """Contact of two touching particles i, j at separation d = x_j - x_i (m; ``dist`` =
+    ``|d|`` below r_i + r_j): radii (m), velocities (m/s), spins (1/s), masses (kg),
+    inertias (kg m^2), the pair's property row, linear moduli ``ei``/``ej`` (Pa), its shear
+    history ``hist`` (updated). Returns (force on j (3, N; i gets minus it), torque on i
+    (3, N m), torque on j (3, N m), overlap m, normal force N, energy J, kn N/m). Scalars
+    and two rows only, so it inlines into the pair loops without reference counting."""
+    delta = ri + rj - dist
+    inv = 1.0 / dist
+    n0 = d0 * inv
+    n1 = d1 * inv
+    n2 = d2 * inv
+    ai = ri - 0.5 * delta
+    aj = rj - 0.5 * delta
+    # v_c = v + omega x arm: body i arm +ai n, body j arm -aj n
+    v0 = (vj0 - aj * (wj1 * n2 - wj2 * n1)) - (vi0 + ai * (wi1 * n2 - wi2 * n1))
+    v1 = (vj1 - aj * (wj2 * n0 - wj0 * n2)) - (vi1 + ai * (wi2 * n0 - wi0 * n2))
+    v2 = (vj2 - aj * (wj0 * n1 - wj1 * n0)) - (vi2 + ai * (wi0 * n1 - wi1 * n0))
+    rstar = ri * rj / (ri + rj)
+    mstar = mi * mj / (mi + mj)
+    istar = ii * ij / (ii + ij)
+    law = int(prop[P_LAW])
+    lin_k = 0.0
+    if law == LINEAR:
+        rmin = ri if ri < rj else rj
+        area = 2.0 * rmin * thickness if dim == 2 else np.pi * rmin * rmin
+        lin_k = area / (ri / ei + rj / ej)
+    f0, f1, f2, r0, r1, r2, fn, energy, kn = contact_response(
+        law, prop, n0, n1, n2, delta, v0, v1, v2, wi0 - wj0, wi1 - wj1,
+        wi2 - wj2, rstar, mstar, istar, lin_k, hist, dt)
+    # torque = arm x force; body j: (-aj n) x F ; body i: (ai n) x (-F)
+    tx = n1 * f2 - n2 * f1
+    ty = n2 * f0 - n0 * f2
+    tz = n0 * f1 - n1 * f0
+    return (f0, f1, f2, -ai * tx + r0, -ai * ty + r1, -ai * tz + r2, -aj * tx - r0,
+            -aj * ty - r1, -aj * tz - r2, delta, fn, energy, kn)
+
+
 @kernel(chunk=512)
 def pair_forces(pos, vel, omega, radius, mass, inertia, mat, pair_i, pair_j, hist, pairtab,
                 elin, length, periodic, dim, thickness, dt, fpair, tpair_i, tpair_j, pinfo):
@@ -256,6 +296,7 @@ def pair_forces(pos, vel, omega, radius, mass, inertia, mat, pair_i, pair_j, his
     fpair[p]: force on j (i gets minus it); tpair_i/tpair_j: torques (N m);
     pinfo[p] = (overlap m, normal force N, energy J, kn N/m). A pair found apart is
     cleared only if it was in contact (pinfo[p, 0] > 0) at the previous evaluation.
+    Particles gather these in ``integrate.advance`` (threaded runs).
     """
     m = pair_i.shape[0]
     for p in prange(m):
@@ -264,12 +305,22 @@ def pair_forces(pos, vel, omega, radius, mass, inertia, mat, pair_i, pair_j, his
         d0 = min_image(pos[j, 0] - pos[i, 0], length[0], periodic[0])
         d1 = min_image(pos[j, 1] - pos[i, 1], length[1], periodic[1])
         d2 = min_image(pos[j, 2] - pos[i, 2], length[2], periodic[2])
-        dist = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
         ri = radius[i]
         rj = radius[j]
-        delta = ri + rj - dist
-        if delta <= 0.0 or dist == 0.0:
-            if pinfo[p, 0] > 0.0:  # the contact just ended: clear it once
+        dist2 = d0 * d0 + d1 * d1 + d2 * d2
+        rs = ri + rj
+        f0 = f1 = f2 = a0 = a1 = a2 = b0 = b1 = b2 = fn = energy = kn = 0.0
+        dist = np.sqrt(dist2)
+        delta = rs - dist
+        if delta > 0.0 and dist2 > 0.0:
+            (f0, f1, f2, a0, a1, a2, b0, b1, b2, delta, fn, energy, kn) = _pair(
+                d0, d1, d2, dist, ri, rj, vel[i, 0], vel[i, 1], vel[i, 2], vel[j, 0], vel[j, 1],
+                vel[j, 2], omega[i, 0], omega[i, 1], omega[i, 2], omega[j, 0], omega[j, 1],
+                omega[j, 2], mass[i], mass[j], inertia[i], inertia[j],
+                pairtab[mat[i], mat[j]], elin[mat[i]], elin[mat[j]], dim, thickness, hist[p],
+                dt)
+        if not (delta > 0.0 and dist2 > 0.0):  # apart: clear a contact that just ended
+            if pinfo[p, 0] > 0.0:
                 for k in range(3):
                     hist[p, k] = 0.0
                     fpair[p, k] = 0.0
@@ -280,45 +331,90 @@ def pair_forces(pos, vel, omega, radius, mass, inertia, mat, pair_i, pair_j, his
                 pinfo[p, 3] = 0.0
             pinfo[p, 0] = delta
             continue
-        inv = 1.0 / dist
-        n0 = d0 * inv
-        n1 = d1 * inv
-        n2 = d2 * inv
-        ai = ri - 0.5 * delta
-        aj = rj - 0.5 * delta
-        # v_c = v + omega x arm: body i arm +ai n, body j arm -aj n
-        wi0, wi1, wi2 = omega[i, 0], omega[i, 1], omega[i, 2]
-        wj0, wj1, wj2 = omega[j, 0], omega[j, 1], omega[j, 2]
-        v0 = (vel[j, 0] - aj * (wj1 * n2 - wj2 * n1)) - (vel[i, 0] + ai * (wi1 * n2 - wi2 * n1))
-        v1 = (vel[j, 1] - aj * (wj2 * n0 - wj0 * n2)) - (vel[i, 1] + ai * (wi2 * n0 - wi0 * n2))
-        v2 = (vel[j, 2] - aj * (wj0 * n1 - wj1 * n0)) - (vel[i, 2] + ai * (wi0 * n1 - wi1 * n0))
-        rstar = ri * rj / (ri + rj)
-        mstar = mass[i] * mass[j] / (mass[i] + mass[j])
-        istar = inertia[i] * inertia[j] / (inertia[i] + inertia[j])
-        prop = pairtab[mat[i], mat[j]]
-        law = int(prop[P_LAW])
-        lin_k = 0.0
-        if law == LINEAR:
-            rmin = ri if ri < rj else rj
-            area = 2.0 * rmin * thickness if dim == 2 else np.pi * rmin * rmin
-            lin_k = area / (ri / elin[mat[i]] + rj / elin[mat[j]])
-        f0, f1, f2, r0, r1, r2, fn, energy, kn = contact_response(
-            law, prop, n0, n1, n2, delta, v0, v1, v2, wi0 - wj0, wi1 - wj1,
-            wi2 - wj2, rstar, mstar, istar, lin_k, hist[p], dt)
         fpair[p, 0] = f0
         fpair[p, 1] = f1
         fpair[p, 2] = f2
-        # torque = arm x force; body j: (-aj n) x F ; body i: (ai n) x (-F)
-        tx = n1 * f2 - n2 * f1
-        ty = n2 * f0 - n0 * f2
-        tz = n0 * f1 - n1 * f0
-        tpair_i[p, 0] = -ai * tx + r0
-        tpair_i[p, 1] = -ai * ty + r1
-        tpair_i[p, 2] = -ai * tz + r2
-        tpair_j[p, 0] = -aj * tx - r0
-        tpair_j[p, 1] = -aj * ty - r1
-        tpair_j[p, 2] = -aj * tz - r2
+        tpair_i[p, 0] = a0
+        tpair_i[p, 1] = a1
+        tpair_i[p, 2] = a2
+        tpair_j[p, 0] = b0
+        tpair_j[p, 1] = b1
+        tpair_j[p, 2] = b2
         pinfo[p, 0] = delta
         pinfo[p, 1] = fn
         pinfo[p, 2] = energy
         pinfo[p, 3] = kn
+
+
+@kernel
+def pair_forces_sum(pos, vel, omega, radius, mass, inertia, mat, pair_i, pair_j, hist, pairtab,
+                    elin, length, periodic, dim, thickness, dt, fpair, tpair_i, tpair_j, pinfo,
+                    force, torque):
+    """Serial pass of ``pair_forces`` that also sums every pair straight into the particles
+    (Newton pairs, as LIGGGHTS): ``force``/``torque`` (N, N m) are zeroed, then each
+    touching pair p adds ``-fpair[p]`` / its torque on i to i and ``+fpair[p]`` / its
+    torque on j to j in increasing p. ``tpair_*`` are not stored (only cleared when a
+    contact ends).
+
+    Particle k thus receives its pairs in increasing p: first those where it is j (owned
+    by lower particles), then its own -- the order in which ``integrate.advance`` gathers
+    them after the threaded ``pair_forces``, so both give bitwise the same sums. Run it
+    through its serial build only (the loop writes shared rows).
+    """
+    n = force.shape[0]
+    for i in range(n):
+        for k in range(3):
+            force[i, k] = 0.0
+            torque[i, k] = 0.0
+    m = pair_i.shape[0]
+    for p in range(m):
+        i = pair_i[p]
+        j = pair_j[p]
+        d0 = min_image(pos[j, 0] - pos[i, 0], length[0], periodic[0])
+        d1 = min_image(pos[j, 1] - pos[i, 1], length[1], periodic[1])
+        d2 = min_image(pos[j, 2] - pos[i, 2], length[2], periodic[2])
+        ri = radius[i]
+        rj = radius[j]
+        dist2 = d0 * d0 + d1 * d1 + d2 * d2
+        rs = ri + rj
+        f0 = f1 = f2 = a0 = a1 = a2 = b0 = b1 = b2 = fn = energy = kn = 0.0
+        dist = np.sqrt(dist2)
+        delta = rs - dist
+        if delta > 0.0 and dist2 > 0.0:
+            (f0, f1, f2, a0, a1, a2, b0, b1, b2, delta, fn, energy, kn) = _pair(
+                d0, d1, d2, dist, ri, rj, vel[i, 0], vel[i, 1], vel[i, 2], vel[j, 0], vel[j, 1],
+                vel[j, 2], omega[i, 0], omega[i, 1], omega[i, 2], omega[j, 0], omega[j, 1],
+                omega[j, 2], mass[i], mass[j], inertia[i], inertia[j],
+                pairtab[mat[i], mat[j]], elin[mat[i]], elin[mat[j]], dim, thickness, hist[p],
+                dt)
+        if not (delta > 0.0 and dist2 > 0.0):  # apart: clear a contact that just ended
+            if pinfo[p, 0] > 0.0:
+                for k in range(3):
+                    hist[p, k] = 0.0
+                    fpair[p, k] = 0.0
+                    tpair_i[p, k] = 0.0
+                    tpair_j[p, k] = 0.0
+                pinfo[p, 1] = 0.0
+                pinfo[p, 2] = 0.0
+                pinfo[p, 3] = 0.0
+            pinfo[p, 0] = delta
+            continue
+        fpair[p, 0] = f0
+        fpair[p, 1] = f1
+        fpair[p, 2] = f2
+        pinfo[p, 0] = delta
+        pinfo[p, 1] = fn
+        pinfo[p, 2] = energy
+        pinfo[p, 3] = kn
+        force[i, 0] -= f0
+        force[i, 1] -= f1
+        force[i, 2] -= f2
+        torque[i, 0] += a0
+        torque[i, 1] += a1
+        torque[i, 2] += a2
+        force[j, 0] += f0
+        force[j, 1] += f1
+        force[j, 2] += f2
+        torque[j, 0] += b0
+        torque[j, 1] += b1
+        torque[j, 2] += b2

@@ -15,9 +15,10 @@ from typing import Protocol
 import numpy as np
 
 from tribodem.dem import laws, neighbors
-from tribodem.dem.contact import HIST, Material, pair_forces, pair_table
+from tribodem.dem.contact import HIST, Material, pair_forces, pair_forces_sum, pair_table
 from tribodem.dem.errors import SimulationUnstable, TimeStepError
 from tribodem.dem.integrate import BLOCK, advance, critical_step
+from tribodem.dem.jit import serial_run
 from tribodem.dem.space import Box
 from tribodem.dem.state import ParticleState
 from tribodem.dem.walls import PlaneWall, near_walls, wall_arrays, wall_forces
@@ -154,6 +155,7 @@ class Simulation:
         self.pinfo = np.zeros((m, 4))
         self.pinfo[:, 0] = 1.0  # unknown yet: the first evaluation clears what is apart
         self._evaluated = False  # pinfo holds no evaluation yet (see _active)
+        self._summed = False  # force/torque hold this step's pair sums (serial kernel)
 
     def add_interaction(self, inter: Interaction) -> None:
         """Add an extra force contribution, evaluated every step after contacts.
@@ -234,12 +236,19 @@ class Simulation:
         self._build_wall_list()
 
     def _pair_forces(self) -> None:
+        """Contacts of the listed pairs. On one thread (or a short list) the serial kernel
+        also sums them into ``force``/``torque`` (Newton pairs, no gather pass); threaded,
+        each pair is stored and ``advance`` gathers them in the same order."""
         p = self.p
-        laws.active(pair_forces).pick(self.nl.n_pairs)(
-            p.pos, p.vel, p.omega, p.radius, p.mass, p.inertia, p.mat, self.nl.pair_i,
-            self.nl.pair_j, self.hist, self.pairtab, self.elin, self.box.length,
-            self.box.periodic, p.dim, p.thickness, self.dt, self.fpair, self.tpair_i,
-            self.tpair_j, self.pinfo)
+        args = (p.pos, p.vel, p.omega, p.radius, p.mass, p.inertia, p.mat, self.nl.pair_i,
+                self.nl.pair_j, self.hist, self.pairtab, self.elin, self.box.length,
+                self.box.periodic, p.dim, p.thickness, self.dt, self.fpair, self.tpair_i,
+                self.tpair_j, self.pinfo)
+        self._summed = serial_run(self.nl.n_pairs)
+        if self._summed:
+            laws.active(pair_forces_sum).serial(*args, self.force, self.torque)
+        else:
+            laws.active(pair_forces).pick(self.nl.n_pairs)(*args)
         self._evaluated = True
 
     def _wall_pass(self) -> None:
@@ -266,10 +275,10 @@ class Simulation:
         advance.pick(p.n)(
             p.pos, p.vel, p.omega, p.radius, p.mass, p.inertia, p.fixed, self.nl.start,
             self.nl.rev_start, self.nl.rev_pair, self.fpair, self.tpair_i, self.tpair_j,
-            self._wforce, self._wtorque, self.dt, self.gravity, self.viscous_damping,
-            self.local_damping, self.ext_force, self.ext_torque, self.force, self.torque,
-            self.nl.ref_pos, self.nl.ref_radius, self.box.lo, self.box.length,
-            self.box.periodic, self.drift)
+            self._summed, self._wstart, self._wforce, self._wtorque, self.dt, self.gravity,
+            self.viscous_damping, self.local_damping, bool(self.interactions), self.ext_force,
+            self.ext_torque, self.force, self.torque, self.nl.ref_pos, self.nl.ref_radius,
+            self.box.lo, self.box.length, self.box.periodic, self.drift)
 
     def step(self, n: int = 1) -> None:
         """Advance ``n`` steps. Raises ``SimulationUnstable`` (recorders flushed) on blow-up.

@@ -44,75 +44,143 @@ def drift_of(pos, ref_pos, radius, ref_radius, i, length, periodic):
 
 
 @njit(cache=True, inline="always")
-def _update(pos, vel, omega, i, f, t, m, inertia, fixed, a, b, local, dt):
-    """Central-difference update of particle i for force f and moment t (seed 000 eqs 4, 7)."""
+def _update(pos, vel, omega, i, f0, f1, f2, t0, t1, t2, m, inertia, fixed, a, b, local, dt):
+    """Central-difference update of particle i for force f and moment t (seed 000 eqs 4, 7);
+    scalars, so the sums stay in registers."""
+    if fixed == 0 and local == 0.0:  # the common case: no fixity, no local damping
+        bm = b / m
+        v0 = a * vel[i, 0] + bm * f0
+        v1 = a * vel[i, 1] + bm * f1
+        v2 = a * vel[i, 2] + bm * f2
+        vel[i, 0] = v0
+        vel[i, 1] = v1
+        vel[i, 2] = v2
+        bi = b / inertia
+        omega[i, 0] = a * omega[i, 0] + bi * t0
+        omega[i, 1] = a * omega[i, 1] + bi * t1
+        omega[i, 2] = a * omega[i, 2] + bi * t2
+        pos[i, 0] += v0 * dt
+        pos[i, 1] += v1 * dt
+        pos[i, 2] += v2 * dt
+        return
     for k in range(3):
         if fixed & (1 << k):
             continue
+        fk = f0 if k == 0 else (f1 if k == 1 else f2)
         v = vel[i, k]
-        vel[i, k] = a * v + b * local_damped(f[k], v, local) / m
+        vel[i, k] = a * v + b * local_damped(fk, v, local) / m
     for k in range(3):
         if fixed & (1 << (k + 3)):
             continue
+        tk = t0 if k == 0 else (t1 if k == 1 else t2)
         w = omega[i, k]
-        omega[i, k] = a * w + b * local_damped(t[k], w, local) / inertia
+        omega[i, k] = a * w + b * local_damped(tk, w, local) / inertia
     for k in range(3):
         pos[i, k] += vel[i, k] * dt
 
 
 @kernel(chunk=2)
 def advance(pos, vel, omega, radius, mass, inertia, fixed, start, rev_start, rev_pair,
-            fpair, tpair_i, tpair_j, wforce, wtorque, dt, gravity, viscous, local, ext_force,
-            ext_torque, force, torque, ref_pos, ref_radius, lo, length, periodic, drift):
-    """One step for every particle: gather pair forces, the wall pass's force and torque
-    (``walls.wall_forces``), external forces, gravity, then the central-difference update
-    with damping and the periodic wrap.
+            fpair, tpair_i, tpair_j, summed, wstart, wforce, wtorque, dt, gravity, viscous,
+            local, has_ext, ext_force, ext_torque, force, torque, ref_pos, ref_radius, lo,
+            length, periodic, drift):
+    """One step for every particle: its pair forces, the wall pass's force and torque
+    (``walls.wall_forces``, particles with near-wall candidates ``wstart``), external
+    forces (``has_ext``), gravity, then the central-difference update with damping and the
+    periodic wrap.
 
-    Writes the total force/torque (``force``, ``torque``) and per-block ``drift`` (largest
-    move plus growth since the last neighbour build, m). Each particle sums its terms in a
-    fixed order, so the results are the same on any number of threads.
+    Pair sums: with ``summed`` they are already in ``force``/``torque`` (the serial
+    ``contact.pair_forces_sum``); otherwise they are gathered from ``fpair``/``tpair_*``
+    in increasing pair index (first the pairs where the particle is j, through the
+    reverse index, then its own), the order of ``pair_forces_sum``: the same bits on any
+    number of threads. Writes the total force/torque without gravity (``force``,
+    ``torque``, N and N m) and per-block ``drift`` (largest move plus growth since the
+    last neighbour build, m).
     """
     n = pos.shape[0]
     nblocks = (n + BLOCK - 1) // BLOCK
     h = 0.5 * viscous * dt
     a = (1.0 - h) / (1.0 + h)
     b = dt / (1.0 + h)
+    g0 = gravity[0]
+    g1 = gravity[1]
+    g2 = gravity[2]
+    wrap = periodic[0] or periodic[1] or periodic[2]
     for blk in prange(nblocks):
         dmax = 0.0
-        f = np.empty(3)
-        t = np.empty(3)
+        dmax2 = 0.0
         for i in range(blk * BLOCK, min(n, (blk + 1) * BLOCK)):
-            for k in range(3):
-                f[k] = ext_force[i, k] + mass[i] * gravity[k]
-                t[k] = ext_torque[i, k]
-            for p in range(start[i], start[i + 1]):
+            if summed:
+                f0 = force[i, 0]
+                f1 = force[i, 1]
+                f2 = force[i, 2]
+                t0 = torque[i, 0]
+                t1 = torque[i, 1]
+                t2 = torque[i, 2]
+            else:
+                f0 = f1 = f2 = t0 = t1 = t2 = 0.0
+                for q in range(rev_start[i], rev_start[i + 1]):
+                    p = rev_pair[q]
+                    f0 += fpair[p, 0]
+                    f1 += fpair[p, 1]
+                    f2 += fpair[p, 2]
+                    t0 += tpair_j[p, 0]
+                    t1 += tpair_j[p, 1]
+                    t2 += tpair_j[p, 2]
+                for p in range(start[i], start[i + 1]):
+                    f0 -= fpair[p, 0]
+                    f1 -= fpair[p, 1]
+                    f2 -= fpair[p, 2]
+                    t0 += tpair_i[p, 0]
+                    t1 += tpair_i[p, 1]
+                    t2 += tpair_i[p, 2]
+            if wstart[i + 1] > wstart[i]:
+                f0 += wforce[i, 0]
+                f1 += wforce[i, 1]
+                f2 += wforce[i, 2]
+                t0 += wtorque[i, 0]
+                t1 += wtorque[i, 1]
+                t2 += wtorque[i, 2]
+            if has_ext:
+                f0 += ext_force[i, 0]
+                f1 += ext_force[i, 1]
+                f2 += ext_force[i, 2]
+                t0 += ext_torque[i, 0]
+                t1 += ext_torque[i, 1]
+                t2 += ext_torque[i, 2]
+            force[i, 0] = f0
+            force[i, 1] = f1
+            force[i, 2] = f2
+            torque[i, 0] = t0
+            torque[i, 1] = t1
+            torque[i, 2] = t2
+            m = mass[i]
+            _update(pos, vel, omega, i, f0 + m * g0, f1 + m * g1, f2 + m * g2, t0, t1, t2, m,
+                     inertia[i], fixed[i], a, b, local, dt)
+            if wrap:
                 for k in range(3):
-                    f[k] -= fpair[p, k]
-                    t[k] += tpair_i[p, k]
-            for q in range(rev_start[i], rev_start[i + 1]):
-                p = rev_pair[q]
-                for k in range(3):
-                    f[k] += fpair[p, k]
-                    t[k] += tpair_j[p, k]
+                    if periodic[k]:
+                        x = pos[i, k] - lo[k]
+                        if x < 0.0 or x >= length[k]:
+                            x -= length[k] * np.floor(x / length[k])
+                            if x >= length[k]:
+                                x -= length[k]
+                            pos[i, k] = lo[k] + x
+            # drift_of without a square root per particle: sqrt is monotonic, so the
+            # largest move is the root of the largest squared move (growth kept apart)
+            dd = 0.0
             for k in range(3):
-                f[k] += wforce[i, k]
-                t[k] += wtorque[i, k]
-            for k in range(3):
-                force[i, k] = f[k] - mass[i] * gravity[k]
-                torque[i, k] = t[k]
-            _update(pos, vel, omega, i, f, t, mass[i], inertia[i], fixed[i], a, b, local, dt)
-            for k in range(3):
-                if periodic[k]:
-                    x = pos[i, k] - lo[k]
-                    if x < 0.0 or x >= length[k]:
-                        x -= length[k] * np.floor(x / length[k])
-                        if x >= length[k]:
-                            x -= length[k]
-                        pos[i, k] = lo[k] + x
-            dd = drift_of(pos, ref_pos, radius, ref_radius, i, length, periodic)
-            if dd > dmax:
-                dmax = dd
-        drift[blk] = dmax
+                dk = min_image(pos[i, k] - ref_pos[i, k], length[k], periodic[k])
+                dd += dk * dk
+            g = radius[i] - ref_radius[i]
+            if g > 0.0:
+                dg = np.sqrt(dd) + g
+                if dg > dmax:
+                    dmax = dg
+            elif dd > dmax2:
+                dmax2 = dd
+        dmove = np.sqrt(dmax2)
+        drift[blk] = dmax if dmax > dmove else dmove
 
 
 def rayleigh_step(radius: float | np.ndarray, density: float | np.ndarray, shear_modulus: float,

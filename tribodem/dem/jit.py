@@ -37,8 +37,10 @@ class Kernel:
         self.parallel = njit(cache=cache, parallel=True)(fn)
 
     def pick(self, size: int) -> Callable[..., Any]:
-        """The build to use for ``size`` items (particles or pairs)."""
-        if size < PARALLEL_MIN:
+        """The build to use for ``size`` items (particles or pairs): the serial one below
+        ``PARALLEL_MIN`` items or on one thread (a threaded region with one thread only
+        adds its launch cost)."""
+        if serial_run(size):
             return self.serial
         return self._chunked if self.chunk else self.parallel
 
@@ -55,3 +57,8 @@ def kernel(fn: Callable[..., Any] | None = None, *, chunk: int = 0) -> Any:
     if fn is None:
         return lambda f: Kernel(f, chunk)
     return Kernel(fn, chunk)
+
+
+def serial_run(size: int) -> bool:
+    """True when a kernel over ``size`` items runs its serial build (see ``Kernel.pick``)."""
+    return size < PARALLEL_MIN or numba.get_num_threads() == 1
