@@ -1,0 +1,248 @@
+"""The ``fe`` first-body backend (CalculiX, plane-strain cylinder on flat) behind the contract.
+
+Closed forms and tolerances:
+
+* Hertz line contact (Johnson 4.45): p0 = sqrt(P' E* / (pi R)) within 2 % (peak window
+  pressure), half-width a = sqrt(4 P' R / (pi E*)) within 2 % from a least-squares fit of
+  p^2 = p0^2 (1 - x^2 / a^2) over the FE contact nodes (within 4 % over the window cells
+  above p0 / 2: the mapping's linear interpolation between nodes);
+* gross slip: |Q| = mu P' within 1 % at both ends of the stroke, opposing the upper body's
+  motion (base.py: traction on the upper body); energy density -q.s >= 0;
+* morphing (seed eqs 3.7-3.8): the area lost by the elements equals the imposed depth
+  profile's integral (exact for a profile linear between columns) to 1e-9.
+
+ccx runs use coarse meshes (h = a/4, one job for the Hertz and slip checks; h = a/2 for the
+command-line run) and skip without ccx.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import shutil
+import stat
+from pathlib import Path
+
+import numpy as np
+import pytest
+from conftest import run_tribodem
+
+from tribodem.contact import ElasticBody, contact_modulus
+from tribodem.contact.fe import PadOnFlat, cylinder_on_flat, hertz_line
+from tribodem.contact.fe.backend import FEContactSolver, cell_average
+from tribodem.contact.fe.ccx import INSTALL_COMMAND
+from tribodem.contact.fe.mesh import element_areas, morph_columns, surface_profile, worn_area
+from tribodem.contact.fe.validate import half_width_fit
+
+needs_ccx = pytest.mark.skipif(shutil.which("ccx") is None,
+                               reason=f"CalculiX ccx not on PATH ({INSTALL_COMMAND})")
+
+E_STAR = contact_modulus(ElasticBody(), ElasticBody())
+LOAD = 1e5  # N/m
+P0, A = hertz_line(LOAD, 4e-3, E_STAR)
+WINDOW = 10 * A
+
+
+# --- no solver needed -------------------------------------------------------------------------
+
+def _mesh(h_over_a: float = 0.25):
+    return cylinder_on_flat(PadOnFlat(radius=4e-3, a=A, h_fine=h_over_a * A, stroke=20e-6,
+                                      size_factor=20))
+
+
+@pytest.mark.parametrize("body", ["lower", "upper"])
+def test_morphing_volume_is_exact(body: str) -> None:
+    """A tent profile with its kinks on columns: the elements lose exactly its area."""
+    mesh = _mesh()
+    x, y0 = surface_profile(mesh, body)
+    h = mesh.h_fine
+    d0, c = 0.3 * h, 6 * h  # depth at x = 0 and half-width of the tent, m
+    wear = d0 * np.maximum(0.0, 1.0 - np.abs(x) / c)
+    morphed = morph_columns(mesh, body, wear)
+    _, y1 = surface_profile(morphed, body)
+    inward = -1.0 if body == "lower" else 1.0  # the flat recedes down, the pad up
+    np.testing.assert_allclose((y1 - y0) * inward, wear, rtol=0, atol=1e-18)
+    exact = d0 * c  # integral of the tent, m^2 per m
+    lost = float(element_areas(mesh).sum() - element_areas(morphed).sum())
+    assert lost == pytest.approx(exact, rel=1e-9)
+    assert worn_area(mesh, morphed, body) == pytest.approx(exact, rel=1e-12)
+    np.testing.assert_array_equal(morphed.nodes[:, 0], mesh.nodes[:, 0])  # columns straight
+    # eq 3.8: every element of a worn column keeps its share of the fine section's height
+    cols = mesh.columns[body]
+    k = mesh.fine_layers
+    j = int(np.argmin(np.abs(x)))
+    before = np.diff(mesh.nodes[cols[j, :k + 1], 1])
+    after = np.diff(morphed.nodes[cols[j, :k + 1], 1])
+    height = abs(mesh.nodes[cols[j, 0], 1] - mesh.nodes[cols[j, k], 1])
+    np.testing.assert_allclose(after / before, (height - d0) / height, rtol=1e-9)
+    deep = cols[:, k:].ravel()  # below the fine section nothing moves
+    np.testing.assert_array_equal(morphed.nodes[deep], mesh.nodes[deep])
+
+
+def test_morphing_smooth_profile_and_limit() -> None:
+    """A parabolic scar sampled on the columns: trapezoid rule error bound; too deep refused."""
+    mesh = _mesh()
+    x, _ = surface_profile(mesh, "lower")
+    d0, c = 1e-6, 0.8 * A
+    wear = d0 * np.maximum(0.0, 1.0 - (x / c) ** 2)
+    area = worn_area(mesh, morph_columns(mesh, "lower", wear), "lower")
+    exact = 4.0 / 3.0 * d0 * c
+    h = mesh.h_fine  # trapezoid error of a parabola: (2c) h^2 |f''| / 12, plus the two ends
+    assert abs(area - exact) <= 2 * c * h * h * 2 * d0 / c**2 / 12 + 2 * d0 * h
+    with pytest.raises(ValueError, match="fine section"):
+        morph_columns(mesh, "lower", np.full(x.size, mesh.info["fine_depth"]))
+
+
+def test_cell_average_conserves_the_integral() -> None:
+    xn = np.array([-2.0, -1.0, 0.0, 0.5, 1.0, 3.0])
+    vn = np.array([0.0, 1.0, 3.0, 2.0, 1.0, 0.0])
+    dx = 0.25
+    centres = np.arange(-16, 16) * dx
+    avg = cell_average(xn, vn, centres, dx)
+    assert float(avg.sum() * dx) == pytest.approx(float(np.sum(0.5 * (vn[1:] + vn[:-1])
+                                                                 * np.diff(xn))), rel=1e-12)
+    assert avg[0] == 0.0 and avg[-1] == 0.0
+
+
+# --- one coarse ccx job: loading and a gross-slip cycle --------------------------------------
+
+AMPLITUDE = 10e-6  # m: gross slip is reached at about 3 um (docs/fe.md)
+
+
+@pytest.fixture(scope="module")
+def served(tmp_path_factory: pytest.TempPathFactory):  # noqa: ANN201
+    solver = FEContactSolver(load=LOAD * WINDOW, window=WINDOW, n=128, amplitude=AMPLITUDE,
+                             n_increments=4, h_over_a=0.25, size_factor=40, threads=1,
+                             timeout=600, workdir=tmp_path_factory.mktemp("fe_backend"))
+    solver.reset()
+    loaded = solver.solve_increment(0.0)
+    solver.begin_cycle()
+    incs = [solver.solve_increment(float(o)) for o in solver.offsets]
+    return solver, loaded, incs
+
+
+@needs_ccx
+def test_backend_hertz_line(served) -> None:  # noqa: ANN001
+    solver, loaded, _ = served
+    assert len(solver.jobs) == 1  # the loading and the first cycle: one job
+    p = loaded.pressure[:, 0]
+    np.testing.assert_array_equal(loaded.pressure, np.repeat(p[:, None], solver.n, axis=1))
+    assert loaded.normal_load == pytest.approx(solver.load, rel=1e-3)
+    assert p.max() == pytest.approx(P0, rel=0.02)
+    # half-width: the FE nodes (the model), and the window cells (the model mapped)
+    a_nodes, _ = half_width_fit(solver.results.contact[solver.results.at(2.0)], P0)
+    assert a_nodes == pytest.approx(A, rel=0.02)
+    x = solver.coords
+    inner = p > 0.5 * p.max()  # away from the edge cells, which the mapping smears
+    slope, icpt = np.polyfit(x[inner] ** 2, p[inner] ** 2, 1)  # p^2 = p0^2 (1 - x^2 / a^2)
+    # the window holds cell averages of the nodes' piecewise-linear interpolant, which
+    # flattens the elliptical profile between nodes: measured -2.7 % at h = a/4
+    assert math.sqrt(icpt / -slope) == pytest.approx(A, rel=0.04)
+    assert loaded.direction == 0.0 and not loaded.slip.any()
+
+
+@needs_ccx
+def test_backend_gross_slip_and_signs(served) -> None:  # noqa: ANN001
+    solver, _, incs = served
+    mu, dx = solver.friction, solver.dx
+    for inc in incs:
+        assert inc.start_offset + (inc.offset - inc.start_offset) == inc.offset
+        assert np.all(inc.energy_density >= 0.0)
+        raw = -np.einsum("ijk,ijk->ij", inc.traction, inc.slip)
+        assert raw.min() >= -1e-9 * max(raw.max(), 1e-30)  # -q.s >= 0 before any clipping
+        s = inc.slip[..., 0]
+        assert np.all(s * inc.direction >= 0.0)  # the upper body slides the way it moves
+        assert inc.traction[..., 1].max() == 0.0 and inc.slip[..., 1].max() == 0.0
+    for k in (0, 2):  # +A and -A: gross slip, traction on the upper body opposes its motion
+        inc = incs[k]
+        q = float(inc.traction[:, 0, 0].sum() * dx)
+        p = float(inc.pressure[:, 0].sum() * dx)
+        assert p == pytest.approx(LOAD, rel=1e-3)
+        assert -inc.direction * q / (mu * p) == pytest.approx(1.0, abs=0.01)
+    # the cycle dissipates at most the rigid-slip work 4 A mu P (the bodies' compliance
+    # takes part of each stroke) and at least half of it at A = 3 x the gross-slip distance
+    energy = sum(float(i.energy_density.sum()) * dx * dx for i in incs)
+    rigid = 4 * AMPLITUDE * mu * LOAD * solver.window
+    assert 0.5 * rigid < energy < rigid
+
+
+@needs_ccx
+def test_backend_refuses_offsets_out_of_order(served) -> None:  # noqa: ANN001
+    solver, _, _ = served
+    solver._k = 0  # the next increment of a cycle in progress (no new job)
+    solver._served = solver._served or []
+    with pytest.raises(ValueError, match="not increment 1"):
+        solver.solve_increment(0.5 * AMPLITUDE)
+    solver._k = None
+
+
+# --- the command ------------------------------------------------------------------------------
+
+CONFIG = """cycles = 2
+solver = "fe"
+[contact]
+geometry = "cylinder_on_flat"
+radius = 4e-3
+load_per_length = 1.0e5
+amplitude = 10e-6
+n_increments = 4
+n = 64
+[fe]
+h_over_a = 0.5
+[output]
+vtk = false
+figures = false
+"""
+
+
+@needs_ccx
+def test_ccx_failure_stops_the_run_with_exit_3(tmp_path: Path) -> None:
+    """A deck ccx refuses (here: cycle 2's, spoiled by a wrapper in front of the real ccx)
+    stops the run with exit 3, ccx's message and the deck path; cycle 1's outputs stay."""
+    real = shutil.which("ccx")
+    assert real is not None
+    bin_dir = tmp_path / "bin"
+    bin_dir.mkdir()
+    wrapper = bin_dir / "ccx"
+    wrapper.write_text(
+        "#!/bin/sh\n"
+        "case \"$PWD\" in */cycle_0002) sed -i '2a *BOUNDARY\\nNOSUCHSET, 1, 2' \"$2.inp\";;"
+        " esac\n"
+        f"exec {real} \"$@\"\n")
+    wrapper.chmod(wrapper.stat().st_mode | stat.S_IEXEC)
+    cfg = tmp_path / "fe.toml"
+    cfg.write_text(CONFIG)
+    out = tmp_path / "run"
+    env = dict(os.environ, PATH=f"{bin_dir}{os.pathsep}{os.environ['PATH']}")
+    r = run_tribodem("fretting", "run", "--config", str(cfg), "--out", str(out),
+                     "--no-progress", env=env)
+    assert r.returncode == 3, r.stderr
+    assert "Traceback" not in r.stderr
+    deck = out / "fe" / "cycle_0002" / "job.inp"
+    assert str(deck) in r.stderr
+    assert "NOSUCHSET" in r.stderr and "*ERROR" in r.stderr
+    rows = (out / "results.csv").read_text().splitlines()
+    assert len(rows) == 2 and rows[1].startswith("1,")
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["stopped"].startswith("cycle 2")
+    assert (out / "fe" / "cycle_0001" / "job.dat").is_file()
+
+
+def test_missing_ccx_exits_2_with_the_install_command(tmp_path: Path) -> None:
+    cfg = tmp_path / "fe.toml"
+    cfg.write_text(CONFIG)
+    env = dict(os.environ, PATH=str(tmp_path / "nowhere"))
+    r = run_tribodem("fretting", "run", "--config", str(cfg), "--out", str(tmp_path / "run"),
+                     "--no-progress", env=env)
+    assert r.returncode == 2, r.stderr
+    assert INSTALL_COMMAND in r.stderr and "solver = 'fe'" in r.stderr
+    assert "Traceback" not in r.stderr
+    assert not (tmp_path / "run" / "results.csv").exists()
+
+
+def test_fe_refuses_a_point_contact(tmp_path: Path) -> None:
+    r = run_tribodem("fretting", "run", "--solver", "fe", "--cycles", "1", "--out",
+                     str(tmp_path / "run"), "--no-progress")
+    assert r.returncode == 2
+    assert "point_contact" in r.stderr and "solver = 'fe'" in r.stderr
