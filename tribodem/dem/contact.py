@@ -29,6 +29,8 @@ from tribodem.dem.laws.table import (  # noqa: F401 - the table's columns, re-ex
     P_LAW,
     P_MU,
     P_MUR,
+    P_SQ2E,
+    P_SQ8G,
 )
 from tribodem.dem.space import min_image
 
@@ -158,6 +160,8 @@ def set_pair(tab: np.ndarray, a: int, b: int, ma: Material, mb: Material, **over
     row[P_KRATIO] = 0.5 * (ma.kratio + mb.kratio)
     row[P_BETAN] = 0.5 * (ma.beta_n + mb.beta_n)
     row[P_BETAS] = 0.5 * (ma.beta_s + mb.beta_s)
+    row[P_SQ2E] = math.sqrt(2.0 * estar)
+    row[P_SQ8G] = math.sqrt(8.0 * gstar)
     names = {"law": P_LAW, "friction": P_MU, "rolling_friction": P_MUR, "kratio": P_KRATIO,
              "beta_n": P_BETAN, "beta_s": P_BETAS}
     for k, v in override.items():
@@ -172,20 +176,20 @@ def set_pair(tab: np.ndarray, a: int, b: int, ma: Material, mb: Material, **over
 
 
 @njit(cache=True, inline="always")
-def contact_response(law, prop, n0, n1, n2, delta, v0, v1, v2, w0, w1, w2, rstar, mstar, istar,
-                     lin_k, hist, dt):
+def response(law, prop, n0, n1, n2, delta, v0, v1, v2, w0, w1, w2, rstar, mstar, istar, lin_k,
+             h0, h1, h2, dt):
     """Force on the second body and rolling torque on the first, for one contact.
 
     n: unit normal from body 1 to body 2; v: velocity of body 2 minus body 1 at the
-    contact point; w: omega_1 - omega_2. ``hist`` (shear spring, m) is updated in place.
+    contact point; w: omega_1 - omega_2; h: the shear spring (m) before the step.
     Returns (force on body 2 (3, N), rolling torque on body 1 (3, N m; body 2 gets minus
-    it), normal force N, stored energy J, normal stiffness N/m). Scalars only: no
-    allocation in the hot loop.
+    it), normal force N, stored energy J, normal stiffness N/m, the shear spring after the
+    step (3, m)). Scalars only: no array view in the hot loop (numba reference-counts
+    views handed to inlined functions).
     """
     vn = v0 * n0 + v1 * n1 + v2 * n2
     fn, kt, ct, kn, energy = law_normal(law, prop, delta, vn, rstar, mstar, lin_k)
     # shear spring: rotate into the current tangent plane (keep its length), add slip
-    h0, h1, h2 = hist[0], hist[1], hist[2]
     hn = h0 * n0 + h1 * n1 + h2 * n2
     if hn != 0.0:
         len0 = h0 * h0 + h1 * h1 + h2 * h2
@@ -222,9 +226,6 @@ def contact_response(law, prop, n0, n1, n2, delta, v0, v1, v2, w0, w1, w2, rstar
             h0 = 0.0
             h1 = 0.0
             h2 = 0.0
-    hist[0] = h0
-    hist[1] = h1
-    hist[2] = h2
     energy += 0.5 * kt * (h0 * h0 + h1 * h1 + h2 * h2)
     # rolling resistance (constant directional torque), without reversing the spin
     r0 = 0.0
@@ -245,18 +246,47 @@ def contact_response(law, prop, n0, n1, n2, delta, v0, v1, v2, w0, w1, w2, rstar
             r0 = -tq * wr0 / wm
             r1 = -tq * wr1 / wm
             r2 = -tq * wr2 / wm
-    return (fn * n0 + ft0, fn * n1 + ft1, fn * n2 + ft2, r0, r1, r2, fn, energy, kn)
+    return (fn * n0 + ft0, fn * n1 + ft1, fn * n2 + ft2, r0, r1, r2, fn, energy, kn, h0, h1,
+            h2)
+
+
+@njit(cache=True, inline="always")
+def contact_response(law, prop, n0, n1, n2, delta, v0, v1, v2, w0, w1, w2, rstar, mstar, istar,
+                     lin_k, hist, dt):
+    """``response`` with the shear spring in ``hist`` (3, m), updated in place. Returns
+    (force on body 2 (3, N), rolling torque on body 1 (3, N m), normal force N, stored
+    energy J, normal stiffness N/m)."""
+    f0, f1, f2, r0, r1, r2, fn, energy, kn, h0, h1, h2 = response(
+        law, prop, n0, n1, n2, delta, v0, v1, v2, w0, w1, w2, rstar, mstar, istar, lin_k,
+        hist[0], hist[1], hist[2], dt)
+    hist[0] = h0
+    hist[1] = h1
+    hist[2] = h2
+    return f0, f1, f2, r0, r1, r2, fn, energy, kn
+
+
+@njit(cache=True, inline="always")
+def _lin_k(prop, ri, rj, ei, ej, dim, thickness):
+    """PFC deformability stiffness (N/m) of a pair with the linear law (0 for other laws):
+    ``A / (r_i/E_i + r_j/E_j)``, ``A = 2 r_min t`` (2D) or ``pi r_min^2`` (3D)."""
+    if int(prop[P_LAW]) != LINEAR:
+        return 0.0
+    rmin = ri if ri < rj else rj
+    area = 2.0 * rmin * thickness if dim == 2 else np.pi * rmin * rmin
+    return area / (ri / ei + rj / ej)
 
 
 @njit(cache=True, inline="always")
 def _pair(d0, d1, d2, dist, ri, rj, vi0, vi1, vi2, vj0, vj1, vj2, wi0, wi1, wi2, wj0, wj1, wj2, mi,
-          mj, ii, ij, prop, ei, ej, dim, thickness, hist, dt):
+          mj, ii, ij, prop, lin_k, h0, h1, h2, dt):
     """Contact of two touching particles i, j at separation d = x_j - x_i (m; ``dist`` =
     ``|d|`` below r_i + r_j): radii (m), velocities (m/s), spins (1/s), masses (kg),
-    inertias (kg m^2), the pair's property row, linear moduli ``ei``/``ej`` (Pa), its shear
-    history ``hist`` (updated). Returns (force on j (3, N; i gets minus it), torque on i
-    (3, N m), torque on j (3, N m), overlap m, normal force N, energy J, kn N/m). Scalars
-    and two rows only, so it inlines into the pair loops without reference counting."""
+    inertias (kg m^2), the pair's property row, the linear law's stiffness ``lin_k`` (N/m,
+    ``_lin_k``), the shear spring ``h`` (m). Returns (force on j (3, N; i gets minus it),
+    torque on i (3, N m), torque on j (3, N m), overlap m, normal force N, energy J,
+    kn N/m, the new shear spring (3, m)). Scalars and the property row only, so it inlines
+    into the pair loops without reference counting (and stays under 30 arguments: more
+    make CPython pass them as *args, which numba cannot inline)."""
     delta = ri + rj - dist
     inv = 1.0 / dist
     n0 = d0 * inv
@@ -272,20 +302,15 @@ def _pair(d0, d1, d2, dist, ri, rj, vi0, vi1, vi2, vj0, vj1, vj2, wi0, wi1, wi2,
     mstar = mi * mj / (mi + mj)
     istar = ii * ij / (ii + ij)
     law = int(prop[P_LAW])
-    lin_k = 0.0
-    if law == LINEAR:
-        rmin = ri if ri < rj else rj
-        area = 2.0 * rmin * thickness if dim == 2 else np.pi * rmin * rmin
-        lin_k = area / (ri / ei + rj / ej)
-    f0, f1, f2, r0, r1, r2, fn, energy, kn = contact_response(
+    f0, f1, f2, r0, r1, r2, fn, energy, kn, h0, h1, h2 = response(
         law, prop, n0, n1, n2, delta, v0, v1, v2, wi0 - wj0, wi1 - wj1,
-        wi2 - wj2, rstar, mstar, istar, lin_k, hist, dt)
+        wi2 - wj2, rstar, mstar, istar, lin_k, h0, h1, h2, dt)
     # torque = arm x force; body j: (-aj n) x F ; body i: (ai n) x (-F)
     tx = n1 * f2 - n2 * f1
     ty = n2 * f0 - n0 * f2
     tz = n0 * f1 - n1 * f0
     return (f0, f1, f2, -ai * tx + r0, -ai * ty + r1, -ai * tz + r2, -aj * tx - r0,
-            -aj * ty - r1, -aj * tz - r2, delta, fn, energy, kn)
+            -aj * ty - r1, -aj * tz - r2, delta, fn, energy, kn, h0, h1, h2)
 
 
 @kernel(chunk=512)
@@ -313,12 +338,16 @@ def pair_forces(pos, vel, omega, radius, mass, inertia, mat, pair_i, pair_j, his
         dist = np.sqrt(dist2)
         delta = rs - dist
         if delta > 0.0 and dist2 > 0.0:
-            (f0, f1, f2, a0, a1, a2, b0, b1, b2, delta, fn, energy, kn) = _pair(
+            prop = pairtab[mat[i], mat[j]]
+            (f0, f1, f2, a0, a1, a2, b0, b1, b2, delta, fn, energy, kn, h0, h1, h2) = _pair(
                 d0, d1, d2, dist, ri, rj, vel[i, 0], vel[i, 1], vel[i, 2], vel[j, 0], vel[j, 1],
                 vel[j, 2], omega[i, 0], omega[i, 1], omega[i, 2], omega[j, 0], omega[j, 1],
-                omega[j, 2], mass[i], mass[j], inertia[i], inertia[j],
-                pairtab[mat[i], mat[j]], elin[mat[i]], elin[mat[j]], dim, thickness, hist[p],
-                dt)
+                omega[j, 2], mass[i], mass[j], inertia[i], inertia[j], prop,
+                _lin_k(prop, ri, rj, elin[mat[i]], elin[mat[j]], dim, thickness),
+                hist[p, 0], hist[p, 1], hist[p, 2], dt)
+            hist[p, 0] = h0
+            hist[p, 1] = h1
+            hist[p, 2] = h2
         if not (delta > 0.0 and dist2 > 0.0):  # apart: clear a contact that just ended
             if pinfo[p, 0] > 0.0:
                 for k in range(3):
@@ -381,12 +410,16 @@ def pair_forces_sum(pos, vel, omega, radius, mass, inertia, mat, pair_i, pair_j,
         dist = np.sqrt(dist2)
         delta = rs - dist
         if delta > 0.0 and dist2 > 0.0:
-            (f0, f1, f2, a0, a1, a2, b0, b1, b2, delta, fn, energy, kn) = _pair(
+            prop = pairtab[mat[i], mat[j]]
+            (f0, f1, f2, a0, a1, a2, b0, b1, b2, delta, fn, energy, kn, h0, h1, h2) = _pair(
                 d0, d1, d2, dist, ri, rj, vel[i, 0], vel[i, 1], vel[i, 2], vel[j, 0], vel[j, 1],
                 vel[j, 2], omega[i, 0], omega[i, 1], omega[i, 2], omega[j, 0], omega[j, 1],
-                omega[j, 2], mass[i], mass[j], inertia[i], inertia[j],
-                pairtab[mat[i], mat[j]], elin[mat[i]], elin[mat[j]], dim, thickness, hist[p],
-                dt)
+                omega[j, 2], mass[i], mass[j], inertia[i], inertia[j], prop,
+                _lin_k(prop, ri, rj, elin[mat[i]], elin[mat[j]], dim, thickness),
+                hist[p, 0], hist[p, 1], hist[p, 2], dt)
+            hist[p, 0] = h0
+            hist[p, 1] = h1
+            hist[p, 2] = h2
         if not (delta > 0.0 and dist2 > 0.0):  # apart: clear a contact that just ended
             if pinfo[p, 0] > 0.0:
                 for k in range(3):

@@ -204,8 +204,8 @@ class Simulation:
         wp, wn, _, _ = wall_arrays(self.walls)
         if at is not None:
             wp = np.asarray(at, dtype=np.float64).reshape(wp.shape)
-        self._wstart, self._wid = near_walls(self.nl.ref_pos, self.nl.ref_radius, wp, wn,
-                                             self.skin)
+        self._wstart, self._wid, self._wpart, self._wbstart = near_walls(
+            self.nl.ref_pos, self.nl.ref_radius, wp, wn, self.skin, BLOCK)
         self._wall_ref = (wp, wn)
         self._wforce[:] = 0.0
         self._wtorque[:] = 0.0
@@ -260,9 +260,9 @@ class Simulation:
         wp, wn, wv, wm = self._walls_now
         laws.active(wall_forces).pick(p.n)(
             p.pos, p.vel, p.omega, p.radius, p.mass, p.inertia, p.mat, self._wstart,
-            self._wid, wp, wn, wv, wm, self.wall_hist, self.wall_info, self._wsum,
-            self.pairtab, self.elin, p.dim, p.thickness, self.dt, BLOCK, self._wforce,
-            self._wtorque)
+            self._wid, self._wpart, self._wbstart, wp, wn, wv, wm, self.wall_hist,
+            self.wall_info, self._wsum, self.pairtab, self.elin, p.dim, p.thickness, self.dt,
+            self._wforce, self._wtorque)
         tot = self._wsum.sum(axis=0)
         for w_id, w in enumerate(self.walls):
             w.force = tot[w_id, :3].copy()

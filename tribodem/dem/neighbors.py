@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit, prange
 
-from tribodem.dem.jit import kernel
+from tribodem.dem.jit import kernel, serial_run
 from tribodem.dem.space import min_image
 
 
@@ -151,14 +151,73 @@ def _scan(pos, radius, skin, length, periodic, cell, cstart, order, ncell, start
             start[i + 1] = cnt
 
 
+@njit(cache=True, inline="always")
+def _insertion_sort(pj, a, b):
+    """Sort ``pj[a:b]`` in place (rows hold a few entries: no allocation, no recursion)."""
+    for q in range(a + 1, b):
+        v = pj[q]
+        r = q - 1
+        while r >= a and pj[r] > v:
+            pj[r + 1] = pj[r]
+            r -= 1
+        pj[r + 1] = v
+
+
 @kernel
 def _sort_rows(start, pj):
     """Sort each row by j so the list does not depend on the cell traversal order."""
     n = start.shape[0] - 1
     for i in prange(n):
-        a, b = start[i], start[i + 1]
-        if b - a > 1:
-            pj[a:b] = np.sort(pj[a:b])
+        _insertion_sort(pj, start[i], start[i + 1])
+
+
+@njit(cache=True)
+def _scan_serial(pos, radius, skin, length, periodic, cell, cstart, order, ncell):
+    """One serial pass of ``_scan``: the rows (CSR ``start``, ``pj``) found, written and
+    sorted by j as they come (the threaded build counts first, then fills)."""
+    n = pos.shape[0]
+    start = np.zeros(n + 1, dtype=np.int64)
+    cap = 8 * n + 16
+    pj = np.empty(cap, dtype=np.int64)
+    w = 0
+    for i in range(n):
+        c = cell[i]
+        cx = c % ncell[0]
+        cy = (c // ncell[0]) % ncell[1]
+        cz = c // (ncell[0] * ncell[1])
+        a = w
+        for oz in range(-1, 2):
+            z2 = _axis_neighbor(cz, oz, ncell[2], periodic[2])
+            if z2 < 0:
+                continue
+            for oy in range(-1, 2):
+                y2 = _axis_neighbor(cy, oy, ncell[1], periodic[1])
+                if y2 < 0:
+                    continue
+                for ox in range(-1, 2):
+                    x2 = _axis_neighbor(cx, ox, ncell[0], periodic[0])
+                    if x2 < 0:
+                        continue
+                    c2 = x2 + ncell[0] * (y2 + ncell[1] * z2)
+                    for q in range(cstart[c2], cstart[c2 + 1]):
+                        j = order[q]
+                        if j <= i:
+                            continue
+                        dx = min_image(pos[j, 0] - pos[i, 0], length[0], periodic[0])
+                        dy = min_image(pos[j, 1] - pos[i, 1], length[1], periodic[1])
+                        dz = min_image(pos[j, 2] - pos[i, 2], length[2], periodic[2])
+                        cut = radius[i] + radius[j] + skin
+                        if dx * dx + dy * dy + dz * dz < cut * cut:
+                            if w == cap:
+                                cap *= 2
+                                grown = np.empty(cap, dtype=np.int64)
+                                grown[:w] = pj[:w]
+                                pj = grown
+                            pj[w] = j
+                            w += 1
+        _insertion_sort(pj, a, w)
+        start[i + 1] = w
+    return start, pj[:w].copy()
 
 
 @njit(cache=True)
@@ -203,14 +262,19 @@ def build(pos: np.ndarray, radius: np.ndarray, skin: float, box_lo: np.ndarray,
     length = box_hi - box_lo
     lo, csize, ncell = _grid(pos, radius, box_lo, box_hi, periodic, cell_min)
     cell, cstart, order = _bin(pos, lo, csize, ncell, periodic)
-    start = np.zeros(n + 1, dtype=np.int64)
-    dummy = np.empty(0, dtype=np.int64)
-    scan = _scan.pick(n)
-    scan(pos, radius, skin, length, periodic, cell, cstart, order, ncell, start, dummy, False)
-    np.cumsum(start, out=start)
-    pj = np.empty(int(start[-1]), dtype=np.int64)
-    scan(pos, radius, skin, length, periodic, cell, cstart, order, ncell, start, pj, True)
-    _sort_rows.pick(n)(start, pj)
+    if serial_run(n):
+        start, pj = _scan_serial(pos, radius, skin, length, periodic, cell, cstart, order,
+                                 ncell)
+    else:
+        start = np.zeros(n + 1, dtype=np.int64)
+        dummy = np.empty(0, dtype=np.int64)
+        scan = _scan.pick(n)
+        scan(pos, radius, skin, length, periodic, cell, cstart, order, ncell, start, dummy,
+             False)
+        np.cumsum(start, out=start)
+        pj = np.empty(int(start[-1]), dtype=np.int64)
+        scan(pos, radius, skin, length, periodic, cell, cstart, order, ncell, start, pj, True)
+        _sort_rows.pick(n)(start, pj)
     pi = _owner(start, pj.size)
     rs, rp = _reverse(n, pj)
     return NeighborList(start, pi, pj, rs, rp, pos.copy(), radius.copy(), float(skin),

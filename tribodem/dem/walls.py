@@ -213,12 +213,15 @@ def wall_arrays(walls: list[PlaneWall]) -> tuple[np.ndarray, ...]:
 
 
 @njit(cache=True)
-def near_walls(pos, radius, wpoint, wnormal, reach):
-    """CSR of the walls within ``reach`` (m, gap = distance - radius) of each particle, in
-    wall order: walls of particle i are ``wid[wstart[i]:wstart[i+1]]``."""
+def near_walls(pos, radius, wpoint, wnormal, reach, block):
+    """Near-wall candidates: the walls within ``reach`` (m, gap = distance - radius) of each
+    particle, in wall order (``wid[wstart[i]:wstart[i+1]]``), the particles that have any
+    (``wpart``, increasing) and, per block of ``block`` particles, their range in ``wpart``
+    (``wpart[bstart[b]:bstart[b+1]]``)."""
     n = pos.shape[0]
     nw = wpoint.shape[0]
     wstart = np.zeros(n + 1, dtype=np.int64)
+    npart = 0
     for i in range(n):
         c = 0
         for w in range(nw):
@@ -228,7 +231,13 @@ def near_walls(pos, radius, wpoint, wnormal, reach):
             if gap < reach:
                 c += 1
         wstart[i + 1] = wstart[i] + c
+        if c:
+            npart += 1
     wid = np.empty(wstart[n], dtype=np.int64)
+    wpart = np.empty(npart, dtype=np.int64)
+    nblocks = (n + block - 1) // block
+    bstart = np.zeros(nblocks + 1, dtype=np.int64)
+    k = 0
     for i in range(n):
         q = wstart[i]
         for w in range(nw):
@@ -238,59 +247,90 @@ def near_walls(pos, radius, wpoint, wnormal, reach):
             if gap < reach:
                 wid[q] = w
                 q += 1
-    return wstart, wid
+        if wstart[i + 1] > wstart[i]:
+            wpart[k] = i
+            k += 1
+            bstart[i // block + 1] = k
+    for b in range(nblocks):  # blocks without candidates
+        if bstart[b + 1] < bstart[b]:
+            bstart[b + 1] = bstart[b]
+    return wstart, wid, wpart, bstart
 
 
 @kernel(chunk=2)
-def wall_forces(pos, vel, omega, radius, mass, inertia, mat, wstart, wid, wpoint, wnormal,
-                wvel, wmat, whist, winfo, wsum, pairtab, elin, dim, thickness, dt, block,
+def wall_forces(pos, vel, omega, radius, mass, inertia, mat, wstart, wid, wpart, bstart, wpoint,
+                wnormal, wvel, wmat, whist, winfo, wsum, pairtab, elin, dim, thickness, dt,
                 wforce, wtorque):
-    """Contacts of the near-wall candidates: per particle, the sum over its walls (in wall
-    order) of the force (N) and torque (N m) on it -> ``wforce``/``wtorque`` (rows of
-    particles without candidates are left as they are: zero); per-block wall sums
-    ``wsum[block, wall] = (Fx, Fy, Fz, touching, sum kn)`` (blocks of ``block`` particles,
-    summed in order: the same on any number of threads); ``winfo[w, i]`` = (overlap m,
-    normal force N, energy J, kn N/m) and the shear history ``whist[w, i]`` updated."""
-    n = pos.shape[0]
+    """Contacts of the near-wall candidates (``near_walls``): per candidate particle, the
+    sum over its walls (in wall order) of the force (N) and torque (N m) on it ->
+    ``wforce``/``wtorque`` (other rows are not touched: zero); per-block wall sums
+    ``wsum[block, wall] = (Fx, Fy, Fz, touching, sum kn)`` (the blocks of ``bstart``,
+    summed in particle order: the same on any number of threads); ``winfo[w, i]`` =
+    (overlap m, normal force N, energy J, kn N/m) and the shear history ``whist[w, i]``
+    updated. The contact is ``wall_contact`` written out with scalars (no array views
+    but the history and the property row, so nothing is reference counted per contact)."""
     nw = wpoint.shape[0]
-    nblocks = (n + block - 1) // block
+    nblocks = bstart.shape[0] - 1
     for blk in prange(nblocks):
         for w in range(nw):
             for k in range(5):
                 wsum[blk, w, k] = 0.0
-        for i in range(blk * block, min(n, (blk + 1) * block)):
-            a, b = wstart[i], wstart[i + 1]
-            if a == b:
-                continue
+        for c in range(bstart[blk], bstart[blk + 1]):
+            i = wpart[c]
+            x0 = pos[i, 0]
+            x1 = pos[i, 1]
+            x2 = pos[i, 2]
+            r = radius[i]
             f0s = f1s = f2s = t0s = t1s = t2s = 0.0
-            for c in range(a, b):
-                w = wid[c]
-                gap = ((pos[i, 0] - wpoint[w, 0]) * wnormal[w, 0]
-                       + (pos[i, 1] - wpoint[w, 1]) * wnormal[w, 1]
-                       + (pos[i, 2] - wpoint[w, 2]) * wnormal[w, 2]) - radius[i]
-                if gap >= 0.0 and winfo[w, i, 0] <= 0.0:
-                    continue  # apart now and before: nothing to update
-                hit, f0, f1, f2, t0, t1, t2, delta, fn, energy, kn = wall_contact(
-                    pos[i, 0], pos[i, 1], pos[i, 2], vel[i, 0], vel[i, 1], vel[i, 2],
-                    omega[i, 0], omega[i, 1], omega[i, 2], radius[i], mass[i], inertia[i],
-                    mat[i], wpoint[w], wnormal[w], wvel[w], wmat[w], whist[w, i], pairtab,
-                    elin, dim, thickness, dt)
+            for q in range(wstart[i], wstart[i + 1]):
+                w = wid[q]
+                nx = wnormal[w, 0]
+                ny = wnormal[w, 1]
+                nz = wnormal[w, 2]
+                d = (x0 - wpoint[w, 0]) * nx + (x1 - wpoint[w, 1]) * ny + (x2 - wpoint[w, 2]) * nz
+                delta = r - d
+                if delta <= 0.0:
+                    if winfo[w, i, 0] > 0.0:  # apart now, touching before: clear once
+                        for k in range(3):
+                            whist[w, i, k] = 0.0
+                        winfo[w, i, 1] = 0.0
+                        winfo[w, i, 2] = 0.0
+                        winfo[w, i, 3] = 0.0
+                    winfo[w, i, 0] = delta
+                    continue
+                # unit normal from the particle (body 1) to the wall (body 2)
+                n0 = -nx
+                n1 = -ny
+                n2 = -nz
+                w0 = omega[i, 0]
+                w1 = omega[i, 1]
+                w2 = omega[i, 2]
+                arm = d
+                u0 = wvel[w, 0] - (vel[i, 0] + arm * (w1 * n2 - w2 * n1))
+                u1 = wvel[w, 1] - (vel[i, 1] + arm * (w2 * n0 - w0 * n2))
+                u2 = wvel[w, 2] - (vel[i, 2] + arm * (w0 * n1 - w1 * n0))
+                area = 2.0 * r * thickness if dim == 2 else np.pi * r * r
+                # PFC ball-facet: L = r; modulus = harmonic mean of particle and wall moduli
+                lin_k = area * 2.0 / (1.0 / elin[mat[i]] + 1.0 / elin[wmat[w]]) / r
+                prop = pairtab[mat[i], wmat[w]]
+                f0, f1, f2, r0, r1, r2, fn, energy, kn = contact_response(
+                    int(prop[P_LAW]), prop, n0, n1, n2, delta, u0, u1, u2, w0, w1, w2, r,
+                    mass[i], inertia[i], lin_k, whist[w, i], dt)
                 winfo[w, i, 0] = delta
                 winfo[w, i, 1] = fn
                 winfo[w, i, 2] = energy
                 winfo[w, i, 3] = kn
-                if hit:
-                    f0s -= f0
-                    f1s -= f1
-                    f2s -= f2
-                    t0s += t0
-                    t1s += t1
-                    t2s += t2
-                    wsum[blk, w, 0] += f0
-                    wsum[blk, w, 1] += f1
-                    wsum[blk, w, 2] += f2
-                    wsum[blk, w, 3] += 1.0
-                    wsum[blk, w, 4] += kn
+                f0s -= f0
+                f1s -= f1
+                f2s -= f2
+                t0s += -arm * (n1 * f2 - n2 * f1) + r0
+                t1s += -arm * (n2 * f0 - n0 * f2) + r1
+                t2s += -arm * (n0 * f1 - n1 * f0) + r2
+                wsum[blk, w, 0] += f0
+                wsum[blk, w, 1] += f1
+                wsum[blk, w, 2] += f2
+                wsum[blk, w, 3] += 1.0
+                wsum[blk, w, 4] += kn
             wforce[i, 0] = f0s
             wforce[i, 1] = f1s
             wforce[i, 2] = f2s

@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from tribodem.dem.laws.table import P_ESTAR, P_GAMMA, P_GSTAR
+from tribodem.dem.laws.table import P_ESTAR, P_GAMMA, P_GSTAR, P_SQ2E, P_SQ8G
 
 NAME = "hertz"
 TIME_STEP = "rayleigh"  # eq 2.17 of the smaller particle (integrate.critical_step)
@@ -27,6 +27,6 @@ def normal(prop, delta, vn, rstar, mstar, lin_k):
     st = 8.0 * prop[P_GSTAR] * sq
     fe = (4.0 / 3.0) * estar * delta * sq
     gm = prop[P_GAMMA] * np.sqrt(sq * mstar)  # gamma sqrt(S m*) = gm sqrt(S / a)
-    fn = fe - gm * np.sqrt(2.0 * estar) * vn
-    ct = gm * np.sqrt(8.0 * prop[P_GSTAR])
+    fn = fe - gm * prop[P_SQ2E] * vn  # sqrt(2 E*), sqrt(8 G*): from the table
+    ct = gm * prop[P_SQ8G]
     return fn, st, ct, sn, 0.4 * fe * delta
