@@ -1,7 +1,17 @@
-"""CalculiX FE backend: one plane-strain elastic fretting cycle, and the mesh convergence study.
+"""CalculiX FE backend: one plane-strain elastic fretting cycle, the mesh convergence study,
+and the fe backend against the half-space one on the same fretting run.
 
     .venv/bin/python benchmarks/bench_fe.py [--threads 1 2] [--h-over-a 0.125] [--n 16]
     .venv/bin/python benchmarks/bench_fe.py --study 0.5 0.25 0.125 0.0625
+    .venv/bin/python benchmarks/bench_fe.py --compare OUT [--cycles 5] [--h-over-a 0.25]
+
+Compare: ``examples/fretting_cylinder_on_flat.toml`` (R 4 mm, 100 N/mm, +-0.1 mm, 16
+increments, n 64, energy criterion) for ``--cycles`` cycles, run by the installed command
+with ``--solver elastic`` and ``--solver fe`` (``[fe] h_over_a``; 1 ccx thread) into
+OUT/elastic and OUT/fe (a finished run there is reused); prints worn volumes, maximum depths,
+dissipated energy and seconds per cycle, with the fe profile per job from OUT/fe/fe/jobs.csv
+(meshing + morphing + deck, ccx, reading, mapping to the window) and the rest of the cycle
+(criterion, loop, outputs), and the load average before and after.
 
 Cycle: EN24T pad R 4 mm on a flat, 100 N/mm (p0 1.02 GPa, a 62 um), mu 0.6, tangential cycle
 0 -> +3 um -> 0 -> -3 um -> 0 (gross slip at about 1.7 um) in ``--n`` increments; timed:
@@ -14,7 +24,10 @@ Prints JSON lines. Needs ``ccx`` on PATH (apt-get install calculix-ccx).
 from __future__ import annotations
 
 import argparse
+import csv
 import json
+import os
+import subprocess
 import sys
 import tempfile
 import time
@@ -63,6 +76,55 @@ def study(h_over_a: float, threads: int, size_factor: float) -> dict[str, object
             "yield_factor_error": round(vm["value"] / vm["reference"] - 1.0, 4)}
 
 
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def compare(out: Path, cycles: int, h_over_a: float) -> dict[str, object]:
+    """The same cylinder-on-flat energy run on the half-space and on the fe backend."""
+    out.mkdir(parents=True, exist_ok=True)
+    text = (ROOT / "examples" / "fretting_cylinder_on_flat.toml").read_text()
+    lines = [ln for ln in text.splitlines() if not ln.startswith("cycles")]
+    cfg = out / "case.toml"
+    cfg.write_text(f"cycles = {cycles}\n" + "\n".join(lines)
+                   + f"\n\n[fe]\nh_over_a = {h_over_a}\n")
+    exe = Path(sys.executable).with_name("tribodem")
+    res: dict[str, object] = {"case": "compare", "cycles": cycles, "h_over_a": h_over_a,
+                              "config": str(cfg)}
+    for solver in ("elastic", "fe"):
+        run = out / solver
+        load0 = os.getloadavg()
+        if not (run / "summary.json").is_file():
+            subprocess.run([str(exe), "fretting", "run", "--config", str(cfg), "--solver",
+                            solver, "--threads", "1", "--out", str(run), "--no-progress"],
+                           check=True)
+        summ = json.loads((run / "summary.json").read_text())
+        row = {k: summ[k] for k in ("wear_volume_upper_m3", "wear_volume_lower_m3",
+                                    "wear_depth_upper_m", "wear_depth_lower_m",
+                                    "dissipated_energy_total_J", "wall_time_s")}
+        row["seconds_per_cycle"] = summ["wall_time_s"] / summ["cycles_simulated"]
+        row["load_average_before_after"] = [round(load0[0], 2),
+                                            round(os.getloadavg()[0], 2)]
+        if solver == "fe":
+            with open(run / "fe" / "jobs.csv") as fh:
+                jobs = list(csv.DictReader(fh))
+            keys = ("seconds_mesh", "seconds_ccx", "seconds_read", "seconds_map")
+            prof = {k: sum(float(j[k]) for j in jobs) / len(jobs) for k in keys}
+            prof["seconds_criterion_loop_output"] = (summ["wall_time_s"]
+                                                     - sum(prof.values()) * len(jobs)) / len(jobs)
+            row |= {"jobs": len(jobs), "elements": int(jobs[0]["elements"]),
+                    "refined_jobs": sum(int(j["refine"]) > 1 for j in jobs),
+                    "profile_per_job_s": {k: round(v, 3) for k, v in prof.items()},
+                    "mesh_worn_volume_upper_m3": float(jobs[-1]["worn_volume_upper_m3"]),
+                    "mesh_worn_volume_lower_m3": float(jobs[-1]["worn_volume_lower_m3"])}
+        res[solver] = row
+    el, fe = res["elastic"], res["fe"]
+    assert isinstance(el, dict) and isinstance(fe, dict)
+    res["fe_over_elastic"] = {k: round(fe[k] / el[k], 4) for k in (
+        "wear_volume_upper_m3", "wear_volume_lower_m3", "wear_depth_upper_m",
+        "wear_depth_lower_m", "dissipated_energy_total_J", "seconds_per_cycle")}
+    return res
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--threads", type=int, nargs="+", default=[1, 2])
@@ -70,7 +132,12 @@ def main() -> None:
     ap.add_argument("--n", type=int, default=16, help="increments of the cycle")
     ap.add_argument("--size-factor", type=float, default=LineCase.size_factor)
     ap.add_argument("--study", type=float, nargs="*", help="h / a values of the study")
+    ap.add_argument("--compare", type=Path, help="folder of the fe / half-space comparison")
+    ap.add_argument("--cycles", type=int, default=5, help="cycles of the comparison")
     args = ap.parse_args()
+    if args.compare is not None:
+        print(json.dumps(compare(args.compare, args.cycles, args.h_over_a), indent=1))
+        return
     if args.study:
         for h in args.study:
             print(json.dumps(study(h, args.threads[0], args.size_factor)), flush=True)

@@ -168,6 +168,36 @@ def test_backend_gross_slip_and_signs(served) -> None:  # noqa: ANN001
 
 
 @needs_ccx
+def test_backend_subsurface_stress_under_hertz(served) -> None:  # noqa: ANN001
+    """McEwen's line-contact field on the axis (Johnson 4.47-4.48): sigma_zz = -p0 /
+    sqrt(1 + z^2/a^2) within 3 % of p0, the maximum shear 0.300 p0 at z = 0.786 a within 3 %
+    of p0 and one element; the loading's field is the same under both bodies."""
+    solver, loaded, incs = served
+    lower = solver.subsurface_stress(loaded, "lower", depth=2 * A, nz=41)
+    upper = solver.subsurface_stress(loaded, "upper", depth=2 * A, nz=41)
+    i = solver.n // 2  # x = 0
+    z = lower.z
+    szz = lower.stress[:, i, 0, 2]
+    np.testing.assert_allclose(szz, -P0 / np.sqrt(1 + (z / A) ** 2), rtol=0, atol=0.03 * P0)
+    tau = lower.tresca[:, i, 0]
+    k = int(np.argmax(tau))
+    assert tau[k] == pytest.approx(0.300 * P0, abs=0.03 * P0)
+    assert abs(z[k] - 0.786 * A) <= solver.mesh.h_fine
+    np.testing.assert_allclose(upper.stress[:, i, 0, 2], szz, rtol=0, atol=0.03 * P0)
+    assert lower.stress.shape == (41, solver.n, solver.n, 6)
+    # gross slip at +A: at the surface sigma_xz = q under the flat and -q in the pad, q the
+    # traction on the upper body (the half-space backend's convention)
+    inc = incs[0]
+    j = int(np.argmax(inc.pressure[:, 0]))
+    q = inc.traction[j, 0, 0]
+    assert q < 0.0
+    sl = solver.subsurface_stress(inc, "lower", depth=A, nz=5)
+    su = solver.subsurface_stress(inc, "upper", depth=A, nz=5)
+    assert sl.stress[0, j, 0, 4] == pytest.approx(q, rel=0.05)
+    assert su.stress[0, j, 0, 4] == pytest.approx(-q, rel=0.05)
+
+
+@needs_ccx
 def test_backend_refuses_offsets_out_of_order(served) -> None:  # noqa: ANN001
     solver, _, _ = served
     solver._k = 0  # the next increment of a cycle in progress (no new job)

@@ -53,11 +53,14 @@ import numpy as np
 from numpy.typing import NDArray
 
 from tribodem.contact.base import (
+    BODIES,
+    Body,
     Capabilities,
     ElasticBody,
     FirstBodySolver,
     IncrementResult,
     Recession,
+    SubsurfaceStress,
     WindowTooSmallError,
     _check_positive,
     contact_modulus,
@@ -74,11 +77,18 @@ from tribodem.contact.fe.deck import ContactSettings, FEMaterial, LoadCase, writ
 from tribodem.contact.fe.mesh import Mesh, PadOnFlat, cylinder_on_flat, hertz_line, morph_columns
 from tribodem.contact.fe.mesh import worn_area as mesh_worn_area
 from tribodem.contact.fe.model import DEFAULT_H_OVER_A
-from tribodem.contact.fe.results import FEResults, read_results
+from tribodem.contact.fe.results import GAUSS_2X2, FEResults, read_results
 from tribodem.contact.geometry import cylinder, flat, line_window
+from tribodem.contact.halfspace import max_shear, von_mises
 
 #: modes of :class:`FEContactSolver` (``chained`` is not implemented yet: docs/fe.md)
 MODES = ("fresh",)
+
+#: nodal values of a bilinear quadrilateral from its 2x2 Gauss-point values: the inverse of
+#: N_i at the Gauss points (ccx order of :data:`GAUSS_2X2`), [4 nodes, 4 points]
+_EXTRAPOLATE = np.linalg.inv(np.array([[0.25 * (1 + xi * xn) * (1 + eta * en)
+                                        for xn, en in ((-1, -1), (1, -1), (1, 1), (-1, 1))]
+                                       for xi, eta in GAUSS_2X2]))
 
 
 def _second_difference(f: Recession, h: float) -> float:
@@ -140,7 +150,7 @@ class FEContactSolver(FirstBodySolver):
     and its own Newton tolerances).
     """
 
-    capabilities = Capabilities(partial_slip=True, subsurface=False, contacts=("line",))
+    capabilities = Capabilities(partial_slip=True, subsurface=True, contacts=("line",))
 
     def __init__(
         self,
@@ -164,6 +174,7 @@ class FEContactSolver(FirstBodySolver):
         retries: int = 1,
         workdir: str | Path | None = None,
         executable: str = "ccx",
+        stress_depth_radii: float = 4.0,
         regime: str = "gross",
         tolerance: float | None = None,
     ) -> None:
@@ -227,6 +238,9 @@ class FEContactSolver(FirstBodySolver):
         self.workdir: Path | None = None if workdir is None else Path(workdir)
         #: node-to-surface contact, the pair declared once (docs/fe.md, "Reversals": ccx
         #: 2.20's surface-to-surface friction loses 30-40 % of mu P on the return strokes)
+        #: depth (m) down to which the stresses of the window's node columns are printed
+        self.stress_depth = _check_positive("stress_depth_radii",
+                                            stress_depth_radii) * self.hertz[1]
         self.settings = ContactSettings(mu=self.friction, formulation="NODE TO SURFACE",
                                         pair_in_model=True, tension=1e-5 * self.hertz[0])
         self.jobs: list[JobRecord] = []  #: every ccx job run, in order
@@ -254,9 +268,26 @@ class FEContactSolver(FirstBodySolver):
         return FEMaterial(lo.young, lo.poisson), FEMaterial(up.young, up.poisson)
 
     def _base_mesh(self) -> Mesh:
+        """The unworn mesh, with the element sets ``UCOL``/``LCOL`` of the node columns under
+        the window (lower: the window plus the stroke) down to :attr:`stress_depth`."""
         a = self.hertz[1]
-        return cylinder_on_flat(PadOnFlat(radius=self.radius, a=a, h_fine=self.h_over_a * a,
+        mesh = cylinder_on_flat(PadOnFlat(radius=self.radius, a=a, h_fine=self.h_over_a * a,
                                           stroke=self.amplitude, size_factor=self.size_factor))
+        depth = np.full(mesh.n_nodes, np.inf)
+        for body in ("lower", "upper"):
+            cols = mesh.columns[body]
+            depth[cols] = np.abs(mesh.nodes[cols, 1] - mesh.nodes[cols[:, :1], 1])
+        c = self.coords
+        pad = (math.ceil(self.amplitude / self.dx) + 1) * self.dx
+        xe = mesh.nodes[mesh.elements, 0]
+        near = depth[mesh.elements].min(axis=1) < self.stress_depth
+        for name, body, lo, hi in (("LCOL", "LOWER", c[0] - pad, c[-1] + pad),
+                                   ("UCOL", "UPPER", c[0], c[-1])):
+            ids = mesh.element_sets[body]
+            k = ids - 1
+            keep = near[k] & (xe[k].min(axis=1) <= hi) & (xe[k].max(axis=1) >= lo)
+            mesh.element_sets[name] = ids[keep]
+        return mesh
 
     def column_wear(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Worn depth (m, >= 0) at each node column of the (upper, lower) mesh: the current
@@ -385,7 +416,7 @@ class FEContactSolver(FirstBodySolver):
                             split_cycle=True)
             name = "job" if refine == 1 else f"job_refine{refine}"
             deck = write_deck(folder / f"{name}.inp", mesh, case, lower, upper, self.settings,
-                              fine_stress=False)
+                              fine_stress=False, stress_sets=("LCOL", "UCOL"))
             t_mesh += time.perf_counter() - t1
             t2 = time.perf_counter()
             try:
@@ -516,6 +547,102 @@ class FEContactSolver(FirstBodySolver):
                 normal_load=float(p2.sum()) * cell, stick=stick))
         self._loaded_result = out[0]
         self._served = out[1:]
+        self._time_of = {id(inc): float(res.times[k]) for inc, k in zip(out, idx, strict=True)}
+        self._nodal_cache: dict[tuple[str, float], NDArray[np.float64]] = {}
+
+    # -- subsurface stress ----------------------------------------------------------------
+    _time_of: dict[int, float] = {}
+
+    def _nodal_stress(self, body: str, t: float) -> NDArray[np.float64]:
+        """(sxx, syy, szz, sxy) at the nodes (Pa, [n_nodes, 4]; NaN off the column set) at
+        total time ``t``: each element's 2x2 Gauss-point stresses extrapolated to its nodes
+        by the inverse bilinear interpolation, averaged over the elements of a node; on the
+        surface nodes syy and sxy are the recovered contact traction (-p, -q)."""
+        key = (body, t)
+        if key not in self._nodal_cache:
+            elems, ip = self.results.ip_stress(t, "LCOL" if body == "lower" else "UCOL")
+            conn = self.mesh.elements[elems - 1]
+            nodal = np.einsum("ik,mkc->mic", _EXTRAPOLATE, ip)  # [m, 4 nodes, 4 comps]
+            total = np.zeros((self.mesh.n_nodes, 4))
+            count = np.zeros(self.mesh.n_nodes)
+            np.add.at(total, conn, nodal)
+            np.add.at(count, conn, 1.0)
+            with np.errstate(invalid="ignore", divide="ignore"):
+                nodal_avg = total / count[:, None]
+            # at the surface the traction is known: sigma_YY = -p and sigma_xY = -q (the
+            # contact traction on the pad, p and q, acts as (-q, -p) on the flat's outward
+            # normal +Y and (q, p) on the pad's -Y); the Gauss-point extrapolation overshoots
+            # there in the steep Hertz gradient (measured +9 % of p0 at h = a/4)
+            k = int(np.argmin(np.abs(self.results.times - t)))
+            st = self.results.contact[k]
+            top = self.mesh.columns[body][:, 0]
+            xt = self.mesh.nodes[top, 0]
+            if body == "lower":
+                xt = xt - self.results.ref_displacement[k, 0]  # under the pad's node
+            p = np.interp(xt, st.x, np.maximum(st.pressure, 0.0), left=0.0, right=0.0)
+            q = np.interp(xt, st.x, st.shear, left=0.0, right=0.0)
+            known = np.isfinite(nodal_avg[top, 0])
+            nodal_avg[top[known], 1] = -p[known]
+            nodal_avg[top[known], 3] = -q[known]
+            self._nodal_cache = {key: nodal_avg}
+        return self._nodal_cache[key]
+
+    def subsurface_stress(self, result: IncrementResult, body: Body = "lower",
+                          depth: float | None = None, nz: int = 33) -> SubsurfaceStress:
+        """Stress under ``body`` for an increment this solver served (the current cycle's
+        job), on ``nz`` depths 0..``depth`` (m; default 3 half-widths, area / (2 window))
+        and the window's x (lower body: lab x = window x + ``result.offset``), constant along
+        y. Nodal stresses (:meth:`_nodal_stress`) are interpolated along each straight node
+        column by the depth below its (worn) surface node, then linearly between columns.
+        Frame: x, y (the cylinder's axis, the plane-strain out-of-plane direction), z =
+        depth into the body, so sigma_zz is the FE normal stress, sigma_yy the out-of-plane
+        one and sigma_xz = -sigma_xy(FE) under the flat, +sigma_xy(FE) in the pad: at the
+        surface sigma_xz = q under the flat and -q in the pad, q the shear traction on the
+        upper body (the half-space backend's convention)."""
+        if body not in BODIES:
+            raise ValueError(f"body = {body!r} is not allowed: use 'upper' or 'lower'")
+        t = self._time_of.get(id(result))
+        if t is None:
+            raise ValueError("result is not an increment of the fe solver's current job "
+                             "(subsurface stress is kept for the current cycle only)")
+        if int(nz) != nz or nz < 2:
+            raise ValueError(f"nz = {nz!r} is not allowed: must be an integer >= 2")
+        if depth is None:
+            depth = 3.0 * max(result.contact_area, self.dx**2) / (2.0 * self.window)
+        depth = _check_positive("depth", depth)
+        if depth > self.stress_depth * (1 + 1e-9):
+            raise ValueError(f"depth = {depth!r} m is not allowed: the fe solver prints the "
+                             f"column stresses down to {self.stress_depth:.4g} m "
+                             "(stress_depth_radii x the Hertz half-width)")
+        nodal = self._nodal_stress(body, t)
+        cols = self.mesh.columns[body]
+        xs = self.mesh.nodes[cols[:, 0], 0]
+        x = self.coords + (result.offset if body == "lower" else 0.0)
+        z = np.linspace(0.0, depth, int(nz))
+        j = np.clip(np.searchsorted(xs, x, side="right") - 1, 0, xs.size - 2)
+        w = np.clip((x - xs[j]) / (xs[j + 1] - xs[j]), 0.0, 1.0)
+        need = np.unique(np.concatenate([j, j + 1]))
+        prof = {}
+        for c in need:
+            nodes = cols[c]
+            d = np.abs(self.mesh.nodes[nodes, 1] - self.mesh.nodes[nodes[0], 1])
+            v = nodal[nodes]
+            ok = np.isfinite(v[:, 0])
+            if not ok[0] or d[ok].max() < depth * (1 - 1e-9):
+                raise ValueError(f"no column stresses under x = {xs[c]:.4g} m down to depth "
+                                 f"{depth:.4g} m on the {body} body")
+            prof[c] = np.stack([np.interp(z, d[ok], v[ok, k]) for k in range(4)], axis=-1)
+        s2 = np.stack([(1 - w[i]) * prof[j[i]] + w[i] * prof[j[i] + 1]
+                       for i in range(x.size)], axis=1)  # [nz, n, 4] FE components
+        sign = -1.0 if body == "lower" else 1.0
+        voigt = np.zeros((int(nz), self.n, 6))
+        voigt[..., 0] = s2[..., 0]
+        voigt[..., 1] = s2[..., 2]
+        voigt[..., 2] = s2[..., 1]
+        voigt[..., 4] = sign * s2[..., 3]
+        stress = np.repeat(voigt[:, :, None, :], self.n, axis=2)
+        return SubsurfaceStress(body=body, z=z, x=self.coords, y=self.coords, stress=stress,
+                                von_mises=von_mises(stress), tresca=max_shear(stress))
 
     # -- resume ---------------------------------------------------------------------------
     def state_dict(self) -> dict[str, Any]:

@@ -189,8 +189,10 @@ def _time_points(out: io.StringIO, name: str, times: np.ndarray) -> None:
 
 
 def _outputs(out: io.StringIO, plastic: bool, fine_stress: bool, frd: bool,
-             time_points: str) -> None:
+             time_points: str, stress_sets: tuple[str, ...] = ()) -> None:
     tp = f", TIME POINTS={time_points}" if time_points else ""
+    for name in stress_sets:
+        out.write(f"*EL PRINT, ELSET={name}{tp}\nS\n")
     out.write(f"*NODE PRINT, NSET=LBOT, TOTALS=ONLY{tp}\nRF\n")
     out.write(f"*NODE PRINT, NSET=REF{tp}\nU\n")
     out.write(f"*NODE PRINT, NSET=UBOT{tp}\nU\n*NODE PRINT, NSET=LTOP{tp}\nU\n")
@@ -206,12 +208,13 @@ def _outputs(out: io.StringIO, plastic: bool, fine_stress: bool, frd: bool,
 def write_deck(path: str | Path, mesh: Mesh, case: LoadCase,
                lower: FEMaterial | None = None, upper: FEMaterial | None = None,
                contact: ContactSettings | None = None, fine_stress: bool = True,
-               frd: bool = False) -> Path:
+               frd: bool = False, stress_sets: tuple[str, ...] = ()) -> Path:
     """Write the ccx deck for ``mesh`` and ``case`` to ``path`` (``.inp``); returns the path.
 
     ``fine_stress``: print the integration-point stresses (and PEEQ) of the fine zones to the
     ``.dat`` every increment; ``frd``: also write displacements and stresses to the ``.frd``
-    (for ParaView via ccx2paraview)."""
+    (for ParaView via ccx2paraview); ``stress_sets``: element sets of ``mesh`` whose
+    integration-point stresses are printed too."""
     lower = lower or FEMaterial()
     upper = upper or FEMaterial()
     contact = contact or ContactSettings()
@@ -244,7 +247,7 @@ def write_deck(path: str | Path, mesh: Mesh, case: LoadCase,
     out.write("*STEP, INC=200\n*STATIC\n0.5, 1., 1e-4, 0.5\n")
     _change_friction(out, mesh, lower, upper, contact, loading=True)
     out.write(f"*BOUNDARY\n{ref}, 1, 1, 0.\n{ref}, 2, 2, {_fmt(-seat)}\n")
-    _outputs(out, plastic, fine_stress, frd, "")
+    _outputs(out, plastic, fine_stress, frd, "", stress_sets)
     out.write("*END STEP\n")
     # step 2: normal load P on REF (automatic increments <= 1 / n_load, output at 1 / n_load)
     refine = max(int(case.refine), 1)
@@ -252,7 +255,7 @@ def write_deck(path: str | Path, mesh: Mesh, case: LoadCase,
     out.write(f"*STEP, INC=1000\n*STATIC\n{dt}, 1., {dt * 1e-4}, {dt}\n")
     out.write(f"*BOUNDARY, OP=NEW\nLBOT, 1, 2\n{ref}, 1, 1, 0.\n")
     out.write(f"*CLOAD\n{ref}, 2, {_fmt(-case.load)}\n" + controls)
-    _outputs(out, plastic, fine_stress, frd, "TLOAD")
+    _outputs(out, plastic, fine_stress, frd, "TLOAD", stress_sets)
     out.write("*END STEP\n")
     # step 3: tangential displacement cycle (increments <= 4 / n, output every 4 / n)
     if case.delta > 0 and case.split_cycle:
@@ -263,14 +266,14 @@ def write_deck(path: str | Path, mesh: Mesh, case: LoadCase,
             if k == 0:
                 _change_friction(out, mesh, lower, upper, contact, loading=False)
             out.write(f"*BOUNDARY\n{ref}, 1, 1, {_fmt(target)}\n" + controls)
-            _outputs(out, plastic, fine_stress, frd, "TQUARTER")
+            _outputs(out, plastic, fine_stress, frd, "TQUARTER", stress_sets)
             out.write("*END STEP\n")
     elif case.delta > 0:
         dt = 4.0 / (n * refine)
         out.write(f"*STEP, INC=10000\n*STATIC\n{dt}, {total}, {dt * 1e-4}, {dt}\n")
         _change_friction(out, mesh, lower, upper, contact, loading=False)
         out.write(f"*BOUNDARY, AMPLITUDE=STROKE\n{ref}, 1, 1, {_fmt(case.delta)}\n" + controls)
-        _outputs(out, plastic, fine_stress, frd, "TCYCLE")
+        _outputs(out, plastic, fine_stress, frd, "TCYCLE", stress_sets)
         out.write("*END STEP\n")
     path = Path(path)
     path.write_text(out.getvalue())
