@@ -673,7 +673,8 @@ def build_solver(cfg: FrettingConfig) -> FirstBodySolver:
     if backend is FEContactSolver:
         fe = cfg.fe.model_dump()
         fe["threads"] = runs.check_threads(fe["threads"], "fe.threads (--threads)")
-        kw |= fe | {"amplitude": c.amplitude, "n_increments": c.n_increments}
+        kw |= fe | {"amplitude": c.amplitude, "n_increments": c.n_increments,
+                    "stress_depth": cfg.wear.stress_depth}
     try:
         return backend(upper, lower, **kw)
     except CcxNotFoundError as err:

@@ -143,9 +143,11 @@ class FEContactSolver(FirstBodySolver):
     half-widths); ``amplitude`` (m) and ``n_increments`` of the loop's cycle (the job's
     output times); ``h_over_a`` (element size at the contact / Hertz half-width) and
     ``size_factor`` (bodies' size / a) of the mesh (defaults from the convergence study in
-    docs/fe.md); ``threads``, ``timeout`` (s per ccx job), ``retries`` (after a
-    non-convergence, each retry halves the largest increment); ``workdir``: the folder of the
-    jobs (``cycle_0001/`` ...; None: a new temporary folder). ``regime`` and ``tolerance``
+    docs/fe.md); ``stress_depth`` (m): how deep the column stresses are printed (None: 4 a
+    and 1.5 x the threshold criteria's default depth); ``threads``, ``timeout`` (s per ccx
+    job), ``retries`` (after a non-convergence, each retry halves the largest increment);
+    ``workdir``: the folder of the jobs (``cycle_0001/`` ...; None: a new temporary
+    folder). ``regime`` and ``tolerance``
     are the half-space's options and are not used (the FE interface always has partial slip
     and its own Newton tolerances).
     """
@@ -174,7 +176,7 @@ class FEContactSolver(FirstBodySolver):
         retries: int = 1,
         workdir: str | Path | None = None,
         executable: str = "ccx",
-        stress_depth_radii: float = 4.0,
+        stress_depth: float | None = None,
         regime: str = "gross",
         tolerance: float | None = None,
     ) -> None:
@@ -238,9 +240,13 @@ class FEContactSolver(FirstBodySolver):
         self.workdir: Path | None = None if workdir is None else Path(workdir)
         #: node-to-surface contact, the pair declared once (docs/fe.md, "Reversals": ccx
         #: 2.20's surface-to-surface friction loses 30-40 % of mu P on the return strokes)
-        #: depth (m) down to which the stresses of the window's node columns are printed
-        self.stress_depth = _check_positive("stress_depth_radii",
-                                            stress_depth_radii) * self.hertz[1]
+        #: depth (m) down to which the stresses of the window's node columns are printed:
+        #: given, else 4 half-widths and 1.5 x the threshold criteria's default grid depth,
+        #: 3 sqrt(area / pi) of the unworn contact area 2 a W (criteria.py)
+        a = self.hertz[1]
+        self.stress_depth = (_check_positive("stress_depth", stress_depth)
+                             if stress_depth is not None else
+                             max(4.0 * a, 4.5 * math.sqrt(2.0 * a * self.window / math.pi)))
         self.settings = ContactSettings(mu=self.friction, formulation="NODE TO SURFACE",
                                         pair_in_model=True, tension=1e-5 * self.hertz[0])
         self.jobs: list[JobRecord] = []  #: every ccx job run, in order
@@ -613,7 +619,7 @@ class FEContactSolver(FirstBodySolver):
         if depth > self.stress_depth * (1 + 1e-9):
             raise ValueError(f"depth = {depth!r} m is not allowed: the fe solver prints the "
                              f"column stresses down to {self.stress_depth:.4g} m "
-                             "(stress_depth_radii x the Hertz half-width)")
+                             "(its stress_depth; wear.stress_depth of a fretting config)")
         nodal = self._nodal_stress(body, t)
         cols = self.mesh.columns[body]
         xs = self.mesh.nodes[cols[:, 0], 0]
