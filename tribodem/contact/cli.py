@@ -22,6 +22,9 @@ def validate(
     as_json: Annotated[bool, typer.Option("--json", help="A JSON list of checks.")] = False,
     keep: Annotated[Path | None, typer.Option(
         "--keep", help="fe: keep the CalculiX jobs in this folder.")] = None,
+    three_d: Annotated[bool, typer.Option(
+        "--3d/--no-3d", help="fe: also the 3D crossed-cylinder checks (minutes of ccx).")
+    ] = True,
 ) -> None:
     """Closed-form checks of a first-body backend: Hertz (point, line), Cattaneo-Mindlin,
     gross slip, first yield. Errors are relative, absolute (m) where the name says (m).
@@ -38,6 +41,10 @@ def validate(
 
         with tempfile.TemporaryDirectory(prefix="tribodem_fe_") as tmp:
             checks = validate_fe(keep or tmp, threads=1)
+            if three_d:
+                from tribodem.contact.fe.crossed import crossed_checks
+
+                checks += crossed_checks(Path(keep or tmp), threads=1)
     else:
         from tribodem.contact.validate import halfspace_checks
 
