@@ -300,7 +300,7 @@ def _pair(d0, d1, d2, dist, ri, rj, vi0, vi1, vi2, vj0, vj1, vj2, wi0, wi1, wi2,
     v2 = (vj2 - aj * (wj0 * n1 - wj1 * n0)) - (vi2 + ai * (wi0 * n1 - wi1 * n0))
     rstar = ri * rj / (ri + rj)
     mstar = mi * mj / (mi + mj)
-    istar = ii * ij / (ii + ij)
+    istar = ii * ij / (ii + ij) if prop[P_MUR] > 0.0 else 0.0  # rolling friction only
     law = int(prop[P_LAW])
     f0, f1, f2, r0, r1, r2, fn, energy, kn, h0, h1, h2 = response(
         law, prop, n0, n1, n2, delta, v0, v1, v2, wi0 - wj0, wi1 - wj1,

@@ -12,6 +12,7 @@ import json
 from pathlib import Path
 from typing import Protocol
 
+import numba
 import numpy as np
 
 from tribodem.dem import laws, neighbors
@@ -21,7 +22,13 @@ from tribodem.dem.integrate import BLOCK, advance, critical_step
 from tribodem.dem.jit import serial_run
 from tribodem.dem.space import Box
 from tribodem.dem.state import ParticleState
-from tribodem.dem.walls import PlaneWall, near_walls, wall_arrays, wall_forces
+from tribodem.dem.walls import (
+    PlaneWall,
+    near_walls,
+    needs_rebuild,
+    wall_arrays,
+    wall_forces,
+)
 from tribodem.io.results import write_npz
 
 CHECKPOINT_VERSION = 1
@@ -90,6 +97,7 @@ class Simulation:
         self.nl = neighbors.build(self.p.pos, self.p.radius, self.skin, box.lo, box.hi,
                                   box.periodic)
         self.hist = np.zeros((self.nl.n_pairs, HIST))
+        self._threads: int | None = None  # numba threads, read once per step() call
         self._alloc_pairs()
         self.ext_force = np.zeros((n, 3))
         self.ext_torque = np.zeros((n, 3))
@@ -210,18 +218,13 @@ class Simulation:
         self._wforce[:] = 0.0
         self._wtorque[:] = 0.0
 
-    def _walls_drifted(self) -> bool:
-        """A wall moved more than half the skin along its normal (or turned) since the build."""
-        if not self.walls:
-            return False
-        wp0, wn0 = self._wall_ref
-        wp, wn, _, _ = self._walls_now
-        if not np.array_equal(wn, wn0):
-            return True
-        return float(np.abs(((wp - wp0) * wn).sum(axis=1)).max()) > 0.5 * self.skin
-
     def _maybe_rebuild(self) -> None:
-        if self.drift.max(initial=0.0) <= 0.5 * self.skin and not self._walls_drifted():
+        if self.walls:
+            wp0, wn0 = self._wall_ref
+            wp, wn, _, _ = self._walls_now
+            if not needs_rebuild(self.drift, wp, wn, wp0, wn0, 0.5 * self.skin):
+                return
+        elif self.drift.max(initial=0.0) <= 0.5 * self.skin:
             return
         old, old_hist = self.nl, self.hist
         self.nl = neighbors.build(self.p.pos, self.p.radius, self.skin, self.box.lo,
@@ -244,11 +247,11 @@ class Simulation:
                 self.nl.pair_j, self.hist, self.pairtab, self.elin, self.box.length,
                 self.box.periodic, p.dim, p.thickness, self.dt, self.fpair, self.tpair_i,
                 self.tpair_j, self.pinfo)
-        self._summed = serial_run(self.nl.n_pairs)
+        self._summed = serial_run(self.nl.n_pairs, self._threads)
         if self._summed:
             laws.active(pair_forces_sum).serial(*args, self.force, self.torque)
         else:
-            laws.active(pair_forces).pick(self.nl.n_pairs)(*args)
+            laws.active(pair_forces).pick(self.nl.n_pairs, self._threads)(*args)
         self._evaluated = True
 
     def _wall_pass(self) -> None:
@@ -258,21 +261,24 @@ class Simulation:
             return
         p = self.p
         wp, wn, wv, wm = self._walls_now
-        laws.active(wall_forces).pick(p.n)(
+        laws.active(wall_forces).pick(p.n, self._threads)(
             p.pos, p.vel, p.omega, p.radius, p.mass, p.inertia, p.mat, self._wstart,
             self._wid, self._wpart, self._wbstart, wp, wn, wv, wm, self.wall_hist,
             self.wall_info, self._wsum, self.pairtab, self.elin, p.dim, p.thickness, self.dt,
             self._wforce, self._wtorque)
         tot = self._wsum.sum(axis=0)
+        rows = tot.tolist()  # Python floats: cheaper than numpy scalars for a few walls
         for w_id, w in enumerate(self.walls):
+            f0, f1, f2, nc, kn = rows[w_id]
+            n0, n1, n2 = w.normal.tolist()
             w.force = tot[w_id, :3].copy()
-            w.normal_force = -float(w.force @ w.normal)
-            w.contacts = int(tot[w_id, 3])
-            w.stiffness = float(tot[w_id, 4])
+            w.normal_force = -(f0 * n0 + f1 * n1 + f2 * n2)
+            w.contacts = int(nc)
+            w.stiffness = kn
 
     def _advance(self) -> None:
         p = self.p
-        advance.pick(p.n)(
+        advance.pick(p.n, self._threads)(
             p.pos, p.vel, p.omega, p.radius, p.mass, p.inertia, p.fixed, self.nl.start,
             self.nl.rev_start, self.nl.rev_pair, self.fpair, self.tpair_i, self.tpair_j,
             self._summed, self._wstart, self._wforce, self._wtorque, self.dt, self.gravity,
@@ -288,6 +294,7 @@ class Simulation:
         ``after_advance`` hooks (clump bodies) -> walls move (servo uses the wall force
         just measured).
         """
+        self._threads = numba.get_num_threads()  # once per call: kernels pick builds by it
         try:
             if self.step_count == 0 and self.time == 0.0:
                 self._sample(force=True)

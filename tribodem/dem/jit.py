@@ -36,11 +36,12 @@ class Kernel:
         self.serial = njit(cache=cache)(serial_fn)
         self.parallel = njit(cache=cache, parallel=True)(fn)
 
-    def pick(self, size: int) -> Callable[..., Any]:
+    def pick(self, size: int, threads: int | None = None) -> Callable[..., Any]:
         """The build to use for ``size`` items (particles or pairs): the serial one below
         ``PARALLEL_MIN`` items or on one thread (a threaded region with one thread only
-        adds its launch cost)."""
-        if serial_run(size):
+        adds its launch cost). ``threads``: ``numba.get_num_threads()`` if known (it
+        costs about 2 us a call)."""
+        if serial_run(size, threads):
             return self.serial
         return self._chunked if self.chunk else self.parallel
 
@@ -59,6 +60,8 @@ def kernel(fn: Callable[..., Any] | None = None, *, chunk: int = 0) -> Any:
     return Kernel(fn, chunk)
 
 
-def serial_run(size: int) -> bool:
+def serial_run(size: int, threads: int | None = None) -> bool:
     """True when a kernel over ``size`` items runs its serial build (see ``Kernel.pick``)."""
-    return size < PARALLEL_MIN or numba.get_num_threads() == 1
+    if size < PARALLEL_MIN:
+        return True
+    return (numba.get_num_threads() if threads is None else threads) == 1

@@ -205,6 +205,26 @@ def wall_arrays(walls: list[PlaneWall]) -> tuple[np.ndarray, ...]:
             np.array([w.material for w in walls], dtype=np.int64))
 
 
+@njit(cache=True)
+def needs_rebuild(drift, wpoint, wnormal, wpoint0, wnormal0, half_skin):
+    """Must the neighbour and near-wall lists be rebuilt? True if a particle block drifted
+    more than ``half_skin`` (m; ``drift`` per block from ``advance``), or a wall moved more
+    than ``half_skin`` along its normal or turned since the build (points/normals then:
+    ``wpoint0``/``wnormal0``). One compiled call instead of a few numpy reductions."""
+    for b in range(drift.shape[0]):
+        if drift[b] > half_skin:
+            return True
+    for w in range(wpoint.shape[0]):
+        moved = 0.0
+        for k in range(3):
+            if wnormal[w, k] != wnormal0[w, k]:
+                return True
+            moved += (wpoint[w, k] - wpoint0[w, k]) * wnormal[w, k]
+        if abs(moved) > half_skin:
+            return True
+    return False
+
+
 # ---------------------------------------------------------------------------- the wall pass
 # Plane walls are their own force pass over a near-wall list built with the neighbour list:
 # (particle, wall) candidates whose gap was below the skin at the build. Between builds every
