@@ -1,13 +1,17 @@
-"""DEM engine benchmark: tribodem cases (a) and (b) on 1 and 2 threads, peers on case (a).
+"""DEM engine benchmark: tribodem cases on 1 and 2 threads, peers on the cases they run.
 
     .venv/bin/python benchmarks/bench_dem.py [--quick] [--threads 1 2] [--no-peers]
+                                             [--cases settle3d dense3d ...]
 
 (a) ``settle3d``: 20,000 Hertz-Mindlin spheres settling in an open-top box, 2,000 steps.
 (b) ``compress2d``: 50,000 linear-contact disks compressed between platens, 2,000 steps.
+(c) ``dense3d``: 20,000 Hertz-Mindlin spheres held compressed between six walls
+    (coordination ~6), 2,000 steps.
+(d) ``bonded3d``: 20,000 spheres with ~3 parallel bonds each, uniaxial compression.
 tribodem runs in a fresh process per point (``tribodem bench dem --json``; kernels are
 warmed up before timing). Yade and LIGGGHTS, when installed, run case (a) on the very same
-particles (``benchmarks/peers.py``); the script prints tribodem's per-thread ratio to each.
-Prints a markdown table and a JSON list (for BENCHMARKS.md).
+particles, LIGGGHTS also case (c) (``benchmarks/peers.py``); the script prints tribodem's
+per-thread ratio to each. Prints a markdown table and a JSON list (for BENCHMARKS.md).
 """
 
 from __future__ import annotations
@@ -24,6 +28,14 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 sys.path.insert(0, str(HERE.parent))
+
+
+#: case -> ((particles, steps) full, (particles, steps) --quick)
+ALL_CASES = {"settle3d": ((20_000, 2000), (2000, 200)),
+             "compress2d": ((50_000, 2000), (5000, 200)),
+             "dense3d": ((20_000, 2000), (2000, 200)),
+             "bonded3d": ((20_000, 2000), (2000, 200))}
+PEER_CASES = {"settle3d": ("yade", "liggghts"), "dense3d": ("liggghts",)}
 
 
 def tribodem_point(case: str, n: int, steps: int, threads: int) -> dict:
@@ -49,9 +61,9 @@ def main(argv: list[str] | None = None) -> list[dict]:
     ap.add_argument("--threads", type=int, nargs="+", default=[1, 2])
     ap.add_argument("--no-peers", action="store_true")
     ap.add_argument("--repeat", type=int, default=2, help="runs per point; fastest kept")
+    ap.add_argument("--cases", nargs="+", default=list(ALL_CASES), choices=list(ALL_CASES))
     args = ap.parse_args(argv)
-    sizes = {"settle3d": (2000, 200), "compress2d": (5000, 200)} if args.quick else \
-        {"settle3d": (20_000, 2000), "compress2d": (50_000, 2000)}
+    sizes = {c: (ALL_CASES[c][1] if args.quick else ALL_CASES[c][0]) for c in args.cases}
     results: list[dict] = []
     for case, (n, steps) in sizes.items():
         for t in args.threads:
@@ -63,20 +75,25 @@ def main(argv: list[str] | None = None) -> list[dict]:
     if not args.no_peers:
         import peers
 
-        from tribodem.dem.bench_cases import settle3d_case
+        from tribodem.dem import bench_cases
 
-        n, steps = sizes["settle3d"]
-        case = settle3d_case(n=n, steps=steps)
+        runners = {"yade": peers.run_yade, "liggghts": peers.run_liggghts}
         with tempfile.TemporaryDirectory(prefix="tribodem_peers_") as tmp:
-            for run in (peers.run_yade, peers.run_liggghts):
-                for t in args.threads:
-                    reps = [r for r in (run(case, t, tmp) for _ in range(args.repeat)) if r]
-                    if reps:
-                        best = max(reps, key=lambda r: r["particle_steps_per_s"])
-                        results.append(best)
-                        print(f"# {best['code']} threads={t}: "
-                              f"{best['particle_steps_per_s']:.4g} particle-steps/s",
-                              file=sys.stderr)
+            for cname, codes in PEER_CASES.items():
+                if cname not in sizes:
+                    continue
+                n, steps = sizes[cname]
+                case = getattr(bench_cases, f"{cname}_case")(n=n, steps=steps)
+                for code in codes:
+                    for t in args.threads:
+                        reps = [r for r in (runners[code](case, t, tmp)
+                                            for _ in range(args.repeat)) if r]
+                        if reps:
+                            best = max(reps, key=lambda r: r["particle_steps_per_s"])
+                            results.append(best)
+                            print(f"# {best['code']} {cname} threads={t}: "
+                                  f"{best['particle_steps_per_s']:.4g} particle-steps/s",
+                                  file=sys.stderr)
     print(f"\nMachine: {cpu_name()}, {len(args.threads)} thread counts, date {date.today()}")
     print("Command: .venv/bin/python benchmarks/bench_dem.py"
           + (" --quick" if args.quick else "") + "\n")
@@ -89,9 +106,10 @@ def main(argv: list[str] | None = None) -> list[dict]:
             if r["code"] == "tribodem"}
     print()
     for r in results:
-        if r["code"] != "tribodem" and ("settle3d", r["threads"]) in ours:
-            ratio = ours[("settle3d", r["threads"])] / r["particle_steps_per_s"]
-            print(f"tribodem / {r['code']} on {r['threads']} thread(s), case (a): {ratio:.2f}x")
+        key = (r.get("case", "settle3d"), r["threads"])
+        if r["code"] != "tribodem" and key in ours:
+            ratio = ours[key] / r["particle_steps_per_s"]
+            print(f"tribodem / {r['code']} on {r['threads']} thread(s), {key[0]}: {ratio:.2f}x")
     print("\n" + json.dumps(results, indent=1))
     return results
 

@@ -14,7 +14,8 @@ comparable work (particles fall, contacts form).
 
 Usage::
 
-    python benchmarks/peers.py [--quick] [--threads 1 2] [--codes yade liggghts]
+    python benchmarks/peers.py [--quick] [--case settle3d|dense3d] [--threads 1 2]
+                               [--codes yade liggghts]
 
 Importing this module has no side effects; ``bench_dem.py`` calls ``run_yade`` /
 ``run_liggghts`` directly.
@@ -110,12 +111,17 @@ def _cpu_snapshot() -> tuple[float, float, float]:
     return busy, ru.ru_utime + ru.ru_stime, time.monotonic()
 
 
+_last_child_cpu = [0.0]  # CPU seconds (user + sys) of the last measured command
+
+
 def _run_measured(cmd, **kw) -> tuple[subprocess.CompletedProcess, float]:
     """``subprocess.run`` plus the share of the machine's CPUs used by *other* processes
-    meanwhile (0 = quiet machine; 0.5 on 2 cores = one core busy elsewhere)."""
+    meanwhile (0 = quiet machine; 0.5 on 2 cores = one core busy elsewhere). The CPU
+    seconds the command used (setup included) are left in ``_last_child_cpu[0]``."""
     b0, c0, t0 = _cpu_snapshot()
     proc = subprocess.run(cmd, **kw)
     b1, c1, t1 = _cpu_snapshot()
+    _last_child_cpu[0] = c1 - c0
     others = ((b1 - b0) - (c1 - c0)) / max(t1 - t0, 1e-9) / (os.cpu_count() or 1)
     return proc, max(0.0, min(1.0, others))
 
@@ -192,6 +198,9 @@ def run_yade(case, threads: int, workdir, timeout: float = TIMEOUT_S) -> dict | 
     if exe is None:
         print("peers: yade not found on PATH, skipping", file=sys.stderr)
         return None
+    if getattr(case, "lid", False) or getattr(case, "bonds", None):
+        print(f"peers: case {case.name} (lid or bonds) has no Yade input here", file=sys.stderr)
+        return None
     wd = Path(workdir) / f"yade_{case.name}_n{case.n}_j{threads}"
     wd.mkdir(parents=True, exist_ok=True)
     params = {
@@ -261,13 +270,12 @@ fix m4 all property/global coefficientFriction peratomtypepair 1 {friction:.17g}
 pair_style      gran model hertz tangential history
 pair_coeff      * *
 timestep        {dt:.17g}
-fix gravi all gravity {gmag:.17g} vector {gx:.17g} {gy:.17g} {gz:.17g}
-fix wz0 all wall/gran model hertz tangential history primitive type 1 zplane {zlo:.17g}
+{gravity}fix wz0 all wall/gran model hertz tangential history primitive type 1 zplane {zlo:.17g}
 fix wx0 all wall/gran model hertz tangential history primitive type 1 xplane {xlo:.17g}
 fix wx1 all wall/gran model hertz tangential history primitive type 1 xplane {xhi:.17g}
 fix wy0 all wall/gran model hertz tangential history primitive type 1 yplane {ylo:.17g}
 fix wy1 all wall/gran model hertz tangential history primitive type 1 yplane {yhi:.17g}
-fix integr all nve/sphere
+{lid}fix integr all nve/sphere
 thermo_style    custom step atoms ke
 thermo          {thermo}
 thermo_modify   lost error norm no
@@ -336,10 +344,18 @@ def run_liggghts(case, threads: int, workdir, timeout: float = TIMEOUT_S) -> dic
     gdir = g / gmag if gmag > 0 else np.array([0.0, 0.0, -1.0])
     lo, hi = np.asarray(case.box_lo, float), np.asarray(case.box_hi, float)
     infile = wd / "in.settle"
+    if getattr(case, "wall_speed", 0.0) and getattr(case, "lid", False) or case.bonds:
+        print(f"peers: case {case.name} (moving lid or bonds) has no LIGGGHTS input here",
+              file=sys.stderr)
+        return None
+    gravity = (f"fix gravi all gravity {gmag:.17g} vector {gdir[0]:.17g} {gdir[1]:.17g} "
+               f"{gdir[2]:.17g}\n" if gmag > 0 else "")
+    lid = ("fix wz1 all wall/gran model hertz tangential history primitive type 1 zplane "
+           f"{hi[2]:.17g}\n" if getattr(case, "lid", False) else "")
     infile.write_text(_LIGGGHTS_IN.format(
         data="particles.data", skin=skin_length(case), young=case.young, poisson=case.poisson,
-        cor=case.cor, friction=case.friction, dt=case.dt, gmag=gmag,
-        gx=gdir[0], gy=gdir[1], gz=gdir[2], zlo=lo[2], xlo=lo[0], xhi=hi[0], ylo=lo[1],
+        cor=case.cor, friction=case.friction, dt=case.dt, gravity=gravity, lid=lid,
+        zlo=lo[2], xlo=lo[0], xhi=hi[0], ylo=lo[1],
         yhi=hi[1], thermo=int(case.steps), steps=int(case.steps), final="final.dump",
     ))
     proc = None
@@ -383,6 +399,8 @@ def run_liggghts(case, threads: int, workdir, timeout: float = TIMEOUT_S) -> dic
         "contacts_end_pp": None if cnsum is None else int(round(cnsum / 2)),
         "contacts_end_wall": None,
         "skin_m": skin_length(case), "others_cpu_frac": others,
+        # CPU s of the whole command (mpirun, setup, the final 'run 0' and dump included)
+        "cpu_seconds_process": _last_child_cpu[0],
         "command": " ".join(proc.args),
     }
     out.update(analyse_final(_read_dump(wd / "final.dump"), case))
@@ -417,6 +435,8 @@ def _wait_idle(max_wait_s: float, threads: int) -> float:
 def main(argv=None) -> list[dict]:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--quick", action="store_true", help="n=2000, steps=500")
+    ap.add_argument("--case", default="settle3d", choices=["settle3d", "dense3d"],
+                    help="benchmark case (tribodem.dem.bench_cases): settle3d or dense3d")
     ap.add_argument("--threads", type=int, nargs="+", default=[1, 2])
     ap.add_argument("--codes", nargs="+", default=["yade", "liggghts"],
                     choices=["yade", "liggghts"])
@@ -428,7 +448,8 @@ def main(argv=None) -> list[dict]:
     ap.add_argument("--workdir", default=None, help="keep inputs/logs here (default: temp)")
     args = ap.parse_args(argv)
     bc = _load_cases()
-    case = bc.settle3d_case(n=2000, steps=500) if args.quick else bc.settle3d_case()
+    make = {"settle3d": bc.settle3d_case, "dense3d": bc.dense3d_case}[args.case]
+    case = make(n=2000, steps=500) if args.quick else make()
     runners = {"yade": run_yade, "liggghts": run_liggghts}
     results = []
     with tempfile.TemporaryDirectory(prefix="tribodem_peers_") as tmp:

@@ -8,18 +8,26 @@ from typing import Any
 import numba
 import numpy as np
 
-from tribodem.dem.bench_cases import BenchCase, compress2d_case, settle3d_case
+from tribodem.dem.bench_cases import (
+    BenchCase,
+    bonded3d_case,
+    compress2d_case,
+    dense3d_case,
+    settle3d_case,
+)
 from tribodem.dem.contact import Material
 from tribodem.dem.engine import Simulation
 from tribodem.dem.space import Box
 from tribodem.dem.state import ParticleState
 from tribodem.dem.walls import PlaneWall
 
-CASES = {"settle3d": settle3d_case, "compress2d": compress2d_case}
+CASES = {"settle3d": settle3d_case, "compress2d": compress2d_case, "dense3d": dense3d_case,
+         "bonded3d": bonded3d_case}
 
 
 def simulation_from_case(case: BenchCase) -> Simulation:
-    """Build the tribodem simulation of a benchmark case (box walls, fixed dt)."""
+    """Build the tribodem simulation of a benchmark case (walls on the box faces, fixed dt,
+    the case's parallel bonds)."""
     mat = Material(name="bench", young=case.young, poisson=case.poisson, density=case.density,
                    cor=case.cor, friction=case.friction, law=case.law,
                    beta_n=0.1 if case.law == "linear" else 0.0)
@@ -33,6 +41,10 @@ def simulation_from_case(case: BenchCase) -> Simulation:
                  PlaneWall([hi[0], 0, 0], [-1, 0, 0], name="x+"),
                  PlaneWall([0, lo[1], 0], [0, 1, 0], name="y-"),
                  PlaneWall([0, hi[1], 0], [0, -1, 0], name="y+")]
+        if case.lid:
+            v = case.wall_speed
+            walls.append(PlaneWall([0, 0, hi[2]], [0, 0, -1], name="lid",
+                                   mode="velocity" if v else "fixed", velocity=[0, 0, -v]))
     else:
         v = case.wall_speed
         walls = [PlaneWall([0, lo[1], 0], [0, 1, 0], mode="velocity", velocity=[0, v, 0],
@@ -41,8 +53,13 @@ def simulation_from_case(case: BenchCase) -> Simulation:
                            name="top"),
                  PlaneWall([lo[0], 0, 0], [1, 0, 0], name="left"),
                  PlaneWall([hi[0], 0, 0], [-1, 0, 0], name="right")]
-    return Simulation(p, [mat], Box(lo, hi), walls=walls, gravity=case.gravity, dt=case.dt,
-                      skin=0.15 * 2.0 * float(case.radii.mean()))
+    sim = Simulation(p, [mat], Box(lo, hi), walls=walls, gravity=case.gravity, dt=case.dt,
+                     skin=0.15 * 2.0 * float(case.radii.mean()))
+    if case.bonds:
+        from tribodem.dem.bonds import install_bonds_by_gap
+
+        install_bonds_by_gap(sim, **case.bonds)
+    return sim
 
 
 def run_case(name: str, n: int | None = None, steps: int | None = None,
@@ -62,9 +79,19 @@ def run_case(name: str, n: int | None = None, steps: int | None = None,
     warm.step(10)
     sim = simulation_from_case(case)
     t0 = time.perf_counter()
+    c0 = time.process_time()
     sim.step(case.steps)
     dt_wall = time.perf_counter() - t0
+    dt_cpu = time.process_time() - c0
     z = sim.p.pos[:, 2] if case.dim == 3 else sim.p.pos[:, 1]
+    extra: dict[str, Any] = {}
+    for inter in sim.interactions:  # parallel bonds: count, intact, bytes per bond
+        nb = int(getattr(inter, "i", np.zeros(0)).size)
+        if nb and hasattr(inter, "broken_count"):
+            arrays = [a for a in vars(inter).values()
+                      if isinstance(a, np.ndarray) and a.ndim and a.shape[0] == nb]
+            extra = {"bonds": nb, "bonds_broken": int(inter.broken_count()),
+                     "bytes_per_bond": sum(a.nbytes for a in arrays) / nb}
     return {
         "code": "tribodem",
         "case": name,
@@ -72,12 +99,14 @@ def run_case(name: str, n: int | None = None, steps: int | None = None,
         "steps": case.steps,
         "threads": numba.get_num_threads(),
         "seconds": dt_wall,
+        "cpu_seconds": dt_cpu,  # all threads of this process (loaded machines: see this)
         "particle_steps_per_s": case.n * case.steps / dt_wall,
         "contacts_end": sim.n_contacts(),
+        "coordination_end": 2.0 * sim.n_contacts() / case.n,
         "neighbor_builds": sim.nl.builds,
         "mean_height_end_m": float(np.mean(z)),
         "dt_s": sim.dt,
-        "memory": {**sim.memory(), "peak_rss_bytes": _peak_rss()},
+        "memory": {**sim.memory(), **extra, "peak_rss_bytes": _peak_rss()},
     }
 
 

@@ -166,7 +166,9 @@ def dem_run(
 
 @bench_app.command("dem")
 def bench_dem(
-    case: str = typer.Option("settle3d", "--case", help="settle3d (Hertz) or compress2d."),
+    case: str = typer.Option("settle3d", "--case",
+                             help="settle3d (Hertz), compress2d, dense3d (Hertz, "
+                                  "coordination 6) or bonded3d (bonds, uniaxial compression)."),
     quick: bool = typer.Option(False, "--quick", help="2,000 particles, 200 steps."),
     particles: int | None = typer.Option(None, "--particles", min=10, max=100_000_000),
     steps: int | None = typer.Option(None, "--steps", min=1, max=10**9),
