@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numba import njit, prange
 
-from tribodem.dem.contact import P_LAW, contact_response
+from tribodem.dem.contact import P_LAW, contact_response, response
 from tribodem.dem.jit import kernel
 
 WALL_MODES = ("fixed", "velocity", "servo", "boundary")
@@ -333,9 +333,13 @@ def wall_forces(pos, vel, omega, radius, mass, inertia, mat, wstart, wid, wpart,
                 # PFC ball-facet: L = r; modulus = harmonic mean of particle and wall moduli
                 lin_k = area * 2.0 / (1.0 / elin[mat[i]] + 1.0 / elin[wmat[w]]) / r
                 prop = pairtab[mat[i], wmat[w]]
-                f0, f1, f2, r0, r1, r2, fn, energy, kn = contact_response(
+                f0, f1, f2, r0, r1, r2, fn, energy, kn, h0, h1, h2 = response(
                     int(prop[P_LAW]), prop, n0, n1, n2, delta, u0, u1, u2, w0, w1, w2, r,
-                    mass[i], inertia[i], lin_k, whist[w, i], dt)
+                    mass[i], inertia[i], lin_k, whist[w, i, 0], whist[w, i, 1],
+                    whist[w, i, 2], dt)
+                whist[w, i, 0] = h0
+                whist[w, i, 1] = h1
+                whist[w, i, 2] = h2
                 winfo[w, i, 0] = delta
                 winfo[w, i, 1] = fn
                 winfo[w, i, 2] = energy
