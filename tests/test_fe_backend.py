@@ -278,3 +278,18 @@ def test_fe_refuses_a_point_contact(tmp_path: Path) -> None:
                      str(tmp_path / "run"), "--no-progress")
     assert r.returncode == 2
     assert "point_contact" in r.stderr and "solver = 'fe'" in r.stderr
+
+
+def test_fe_usage_errors_exit_2(tmp_path: Path) -> None:
+    """--threads beyond the cores and a mode that does not exist are refused before any
+    work, naming the field and what is allowed."""
+    cfg = tmp_path / "fe.toml"
+    cfg.write_text(CONFIG)
+    r = run_tribodem("fretting", "run", "--config", str(cfg), "--threads", "999", "--out",
+                     str(tmp_path / "a"), "--no-progress")
+    assert r.returncode == 2 and "--threads = 999" in r.stderr and "allowed" in r.stderr
+    cfg.write_text(CONFIG.replace("[fe]\n", "[fe]\nmode = \"chained\"\n"))
+    r = run_tribodem("fretting", "run", "--config", str(cfg), "--out", str(tmp_path / "b"),
+                     "--no-progress")
+    assert r.returncode == 2 and "fe.mode" in r.stderr and "fresh" in r.stderr
+    assert "Traceback" not in r.stderr
