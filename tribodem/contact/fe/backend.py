@@ -73,7 +73,7 @@ from tribodem.contact.fe.ccx import (
     find_ccx,
     run_ccx,
 )
-from tribodem.contact.fe.deck import ContactSettings, FEMaterial, LoadCase, write_deck
+from tribodem.contact.fe.deck import FEMaterial, LoadCase, sliding_contact, write_deck
 from tribodem.contact.fe.mesh import Mesh, PadOnFlat, cylinder_on_flat, hertz_line, morph_columns
 from tribodem.contact.fe.mesh import worn_area as mesh_worn_area
 from tribodem.contact.fe.results import GAUSS_2X2, FEResults, read_results
@@ -251,8 +251,7 @@ class FEContactSolver(FirstBodySolver):
         self.stress_depth = (_check_positive("stress_depth", stress_depth)
                              if stress_depth is not None else
                              max(4.0 * a, 4.5 * math.sqrt(2.0 * a * self.window / math.pi)))
-        self.settings = ContactSettings(mu=self.friction, formulation="NODE TO SURFACE",
-                                        pair_in_model=True, tension=1e-5 * self.hertz[0])
+        self.settings = sliding_contact(self.friction, self.hertz[0])
         self.jobs: list[JobRecord] = []  #: every ccx job run, in order
         self._mesh0 = self._base_mesh()
         self.reset()

@@ -90,6 +90,15 @@ class ContactSettings:
     tension: float | None = None
 
 
+def sliding_contact(mu: float, p0: float) -> ContactSettings:
+    """The contact set-up of the fretting backend (docs/fe.md, "Reversals"): node-to-surface
+    pair declared once in the model data, ccx's large-clearance tension of the linear law
+    set to 1e-5 ``p0`` (Pa, the Hertz peak pressure); use with ``LoadCase(split_cycle=True)``
+    for full cycles (surface-to-surface friction is wrong on the return strokes)."""
+    return ContactSettings(mu=mu, formulation="NODE TO SURFACE", pair_in_model=True,
+                           tension=1e-5 * p0)
+
+
 @dataclass(frozen=True)
 class LoadCase:
     """Normal load (N/m), tangential amplitude (m) and increments of the tangential cycle."""

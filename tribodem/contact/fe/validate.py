@@ -33,7 +33,7 @@ from numpy.typing import NDArray
 from scipy.optimize import brentq
 
 from tribodem.contact.checks import check
-from tribodem.contact.fe.deck import FEMaterial
+from tribodem.contact.fe.deck import FEMaterial, sliding_contact
 from tribodem.contact.fe.model import LineCase, LineRun, run_line_case
 from tribodem.contact.fe.results import ContactState, ip_coordinates
 
@@ -193,9 +193,11 @@ def plastic_onset_check(run: LineRun) -> list[dict[str, Any]]:
 def default_case(h_over_a: float | None = None) -> LineCase:
     """The validation case: EN24T pad R 4 mm on a flat, 100 N/mm (p0 1.02 GPa < 1.79 Y:
     elastic), bodies 2 x 40 a wide and 40 a high, stroke 3 um in 10 increments (gross slip
-    from about 2 um)."""
+    from about 2 um), with the fretting backend's contact set-up
+    (:func:`tribodem.contact.fe.deck.sliding_contact`: node-to-surface)."""
     kw: dict[str, Any] = {} if h_over_a is None else {"h_over_a": h_over_a}
-    return LineCase(load=1e5, delta=3e-6, n_increments=40, half_cycle=True, **kw)
+    case = LineCase(load=1e5, delta=3e-6, n_increments=40, half_cycle=True, **kw)
+    return dataclasses.replace(case, contact=sliding_contact(case.contact.mu, case.hertz[0]))
 
 
 def validate_fe(folder: str | Path, threads: int = 1, timeout: float = 900.0,
