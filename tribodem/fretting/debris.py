@@ -435,7 +435,12 @@ def run_de_phase(field: DebrisField, lower: NDArray[np.float64], gap: NDArray[np
             converged = True
             break
     pf = lower_s.particle_force.copy()
-    fz = -pf[:, 2]  # force the members push the lower body down with, N (>= 0)
+    # force the members push the lower body down with, N; a separating contact's dashpot can
+    # pull (the Hertz-Mindlin law is not clipped, as in LIGGGHTS): a contact cannot hold the
+    # bodies together, so such pulls are left out of the mapped pressure (reported)
+    fz_raw = -pf[:, 2]
+    tensile = float(-fz_raw[fz_raw < 0.0].sum())
+    fz = np.maximum(fz_raw, 0.0)
     pressure = spread(fz, p.pos[:, 0], p.pos[:, 1], c0, c0, dx, dx, (n, n)) / dx**2
     body_f = np.zeros((field.n, 3))  # force of each body on the lower body, N
     np.add.at(body_f, ia[clumps.body_of[clumps.members]], pf[clumps.members])
@@ -457,5 +462,6 @@ def run_de_phase(field: DebrisField, lower: NDArray[np.float64], gap: NDArray[np
         assumptions={"gravity": "left out (weight ~1e-14 N per particle)",
                      "density_scaling": s.density_scaling,
                      "first_bodies": "rigid height maps at offset 0 (loading position)",
+                     "tensile_member_forces_left_out_N": tensile,
                      "settings": asdict(s)},
     )

@@ -371,7 +371,13 @@ def run_debris_study(cfg: Any, out: Path, counts: tuple[int, ...] = SEED_COUNTS,
         if got is None:
             runs.check_memory(count * 3, 2500.0, "--counts")
             say(f"stage {k + 2}/{len(counts) + 1}: DE phase with {count:,} debris particles")
-            row, arrays = run_count(loop, settings, count, p_without, gap, zones)
+            try:
+                row, arrays = run_count(loop, settings, count, p_without, gap, zones)
+            except (ValueError, RuntimeError) as err:
+                raise runs.RunStopped(
+                    f"DE phase with {count:,} particles: {err} (the wear run and the "
+                    "finished counts are kept; --resume runs the missing counts again)"
+                ) from None
             save_count(out, count, row, arrays)
         else:
             row, arrays = got
