@@ -105,6 +105,7 @@ class Simulation:
         self.wall_info = np.zeros((len(self.walls), n, 4))
         nblocks = (n + BLOCK - 1) // BLOCK
         self._wsum = np.zeros((nblocks, len(self.walls), 5))
+        self._wtot = np.zeros((len(self.walls), 5))  # the walls' sums over the blocks
         self._wforce = np.zeros((n, 3))
         self._wtorque = np.zeros((n, 3))
         self._walls_now = wall_arrays(self.walls)  # refreshed at the start of every step
@@ -265,13 +266,12 @@ class Simulation:
             p.pos, p.vel, p.omega, p.radius, p.mass, p.inertia, p.mat, self._wstart,
             self._wid, self._wpart, self._wbstart, wp, wn, wv, wm, self.wall_hist,
             self.wall_info, self._wsum, self.pairtab, self.elin, p.dim, p.thickness, self.dt,
-            self._wforce, self._wtorque)
-        tot = self._wsum.sum(axis=0)
-        rows = tot.tolist()  # Python floats: cheaper than numpy scalars for a few walls
+            self._wforce, self._wtorque, self._wtot)
+        rows = self._wtot.tolist()  # Python floats: cheaper than numpy scalars for a few walls
         for w_id, w in enumerate(self.walls):
             f0, f1, f2, nc, kn = rows[w_id]
             n0, n1, n2 = w.normal.tolist()
-            w.force = tot[w_id, :3].copy()
+            w.force = np.array((f0, f1, f2))
             w.normal_force = -(f0 * n0 + f1 * n1 + f2 * n2)
             w.contacts = int(nc)
             w.stiffness = kn
