@@ -303,3 +303,22 @@ def test_fe_usage_errors_exit_2(tmp_path: Path) -> None:
                      "--no-progress")
     assert r.returncode == 2 and "fe.mode" in r.stderr and "fresh" in r.stderr
     assert "Traceback" not in r.stderr
+
+
+def test_deck_split_cycles(tmp_path: Path) -> None:
+    """One step per quarter of each cycle (seating + load + 4 x cycles), ramped targets
+    +d, 0, -d, 0, the pair declared once, the node-to-surface tension written."""
+    from tribodem.contact.fe.deck import LoadCase, sliding_contact, write_deck
+
+    mesh = _mesh(0.5)
+    deck = write_deck(tmp_path / "job.inp", mesh,
+                      LoadCase(load=LOAD, delta=5e-6, n_increments=8, split_cycle=True,
+                               cycles=2), contact=sliding_contact(0.6, P0),
+                      fine_stress=False).read_text()
+    assert deck.count("*STEP") == 2 + 4 * 2
+    assert deck.count("*CONTACT PAIR") == 1 and "TYPE=NODE TO SURFACE" in deck
+    ref = int(mesh.node_sets["REF"][0])
+    targets = [ln.split(",")[3].strip() for ln in deck.splitlines()
+               if ln.startswith(f"{ref}, 1, 1,")]
+    assert [float(t) for t in targets[2:]] == [5e-6, 0.0, -5e-6, 0.0] * 2
+    assert f"{1e-5 * P0:.9e}" in deck  # tension at large clearances

@@ -119,6 +119,10 @@ class LoadCase:
     #: ramped boundary values instead of the ``*AMPLITUDE``: ccx 2.20's surface-to-surface
     #: friction keeps a wrong tangential state through a reversal inside one step (docs/fe.md)
     split_cycle: bool = False
+    #: with ``split_cycle``: cycles in the job, one after the other on the same bodies (the
+    #: plastic strain and residual stress carry over; the first piece of ``chained`` mode);
+    #: cycle k ends at total time 2 + 4 k
+    cycles: int = 1
 
 
 def _fmt(v: float) -> str:
@@ -268,7 +272,10 @@ def write_deck(path: str | Path, mesh: Mesh, case: LoadCase,
     out.write("*END STEP\n")
     # step 3: tangential displacement cycle (increments <= 4 / n, output every 4 / n)
     if case.delta > 0 and case.split_cycle:
-        targets = [case.delta, 0.0, -case.delta, 0.0][:1 if case.half_cycle else 4]
+        if int(case.cycles) != case.cycles or case.cycles < 1:
+            raise ValueError(f"cycles = {case.cycles!r} is not allowed: an integer >= 1")
+        targets = ([case.delta, 0.0, -case.delta, 0.0] * int(case.cycles))[
+            :1 if case.half_cycle else None]
         dt = 4.0 / (n * refine)
         for k, target in enumerate(targets):
             out.write(f"*STEP, INC=10000\n*STATIC\n{dt}, 1., {dt * 1e-4}, {dt}\n")
