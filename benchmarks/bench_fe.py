@@ -4,6 +4,7 @@ and the fe backend against the half-space one on the same fretting run.
     .venv/bin/python benchmarks/bench_fe.py [--threads 1 2] [--h-over-a 0.125] [--n 16]
     .venv/bin/python benchmarks/bench_fe.py --study 0.5 0.25 0.125 0.0625
     .venv/bin/python benchmarks/bench_fe.py --compare OUT [--cycles 5] [--h-over-a 0.25]
+    .venv/bin/python benchmarks/bench_fe.py --plastic-cycles 5 [--h-over-a 0.25] [--penalty 10]
 
 Compare: ``examples/fretting_cylinder_on_flat.toml`` (R 4 mm, 100 N/mm, +-0.1 mm, 16
 increments, n 64, energy criterion) for ``--cycles`` cycles, run by the installed command
@@ -12,6 +13,13 @@ OUT/elastic and OUT/fe (a finished run there is reused); prints worn volumes, ma
 dissipated energy and seconds per cycle, with the fe profile per job from OUT/fe/fe/jobs.csv
 (meshing + morphing + deck, ccx, reading, mapping to the window) and the rest of the cycle
 (criterion, loop, outputs), and the load average before and after.
+
+Plastic cycles: bilinear EN24T on both bodies, P = 200 N/mm (p0 = 2.13 Y), +-5 um, 32
+increments per cycle, 10 load increments, the backend's sliding contact set-up
+(node-to-surface, one step per quarter) with the normal penalty ``--penalty`` E/h, all
+cycles in one ccx job (plastic strain and residual stress carry over); prints per cycle the
+PEEQ maxima of the flat's and the pad's fine zones, the PEEQ sum over their Gauss points
+and Q / (mu P) at +A and -A.
 
 Cycle: EN24T pad R 4 mm on a flat, 100 N/mm (p0 1.02 GPa, a 62 um), mu 0.6, tangential cycle
 0 -> +3 um -> 0 -> -3 um -> 0 (gross slip at about 1.7 um) in ``--n`` increments; timed:
@@ -125,6 +133,49 @@ def compare(out: Path, cycles: int, h_over_a: float) -> dict[str, object]:
     return res
 
 
+def plastic_cycles(cycles: int, h_over_a: float, penalty: float) -> dict[str, object]:
+    """Several elastic-plastic cycles in one job (see the module docstring)."""
+    import dataclasses
+
+    import numpy as np
+
+    from tribodem.contact.fe import FEMaterial, LoadCase, read_results, run_ccx, write_deck
+    from tribodem.contact.fe.deck import sliding_contact
+    from tribodem.contact.fe.mesh import PadOnFlat, cylinder_on_flat
+
+    mat = FEMaterial(yield_strength=680e6)
+    delta, load = 5e-6, 2e5
+    case = LineCase(load=load, delta=delta, h_over_a=h_over_a, lower=mat, upper=mat)
+    p0, a = case.hertz
+    mesh = cylinder_on_flat(PadOnFlat(radius=case.radius, a=a, h_fine=h_over_a * a,
+                                      stroke=delta, size_factor=case.size_factor))
+    contact = dataclasses.replace(sliding_contact(0.6, p0), penalty_factor=penalty)
+    rows = []
+    with tempfile.TemporaryDirectory(prefix="bench_fe_") as tmp:
+        deck = write_deck(Path(tmp) / "job.inp", mesh,
+                          LoadCase(load=load, delta=delta, n_increments=32, split_cycle=True,
+                                   load_increments=10, cycles=cycles), mat, mat, contact)
+        run = run_ccx(deck, threads=1, timeout=3600)
+        res = read_results(run.job, mesh)
+    lower = set(mesh.element_sets["LFINE"].tolist())
+    prev = 0.0
+    for k in range(cycles + 1):
+        t = 2.0 + 4.0 * k
+        elems, pe = res.peeq(res.times[res.at(t)])
+        low = np.array([int(e) in lower for e in elems])
+        q = [float(-res.tangential_force[res.at(t - d)] / (0.6 * res.normal_force[res.at(t - d)]))
+             if k else 0.0 for d in (3.0, 1.0)]
+        rows.append({"cycle": k, "peeq_max_flat": float(pe[low].max()),
+                     "peeq_max_pad": float(pe[~low].max()), "peeq_sum": float(pe.sum()),
+                     "peeq_sum_increment": float(pe.sum() - prev),
+                     "Q_over_muP_at_plus_A": round(q[0], 4),
+                     "Q_over_muP_at_minus_A": round(q[1], 4)})
+        prev = float(pe.sum())
+    return {"case": "plastic_cycles", "cycles": cycles, "h_over_a": h_over_a,
+            "penalty": penalty, "p0_over_Y": round(p0 / 680e6, 3),
+            "elements": mesh.n_elements, "seconds_ccx": round(run.seconds, 1), "rows": rows}
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--threads", type=int, nargs="+", default=[1, 2])
@@ -134,7 +185,13 @@ def main() -> None:
     ap.add_argument("--study", type=float, nargs="*", help="h / a values of the study")
     ap.add_argument("--compare", type=Path, help="folder of the fe / half-space comparison")
     ap.add_argument("--cycles", type=int, default=5, help="cycles of the comparison")
+    ap.add_argument("--plastic-cycles", type=int, help="elastic-plastic cycles in one job")
+    ap.add_argument("--penalty", type=float, default=10.0, help="normal penalty / (E / h)")
     args = ap.parse_args()
+    if args.plastic_cycles:
+        print(json.dumps(plastic_cycles(args.plastic_cycles, args.h_over_a, args.penalty),
+                         indent=1))
+        return
     if args.compare is not None:
         print(json.dumps(compare(args.compare, args.cycles, args.h_over_a), indent=1))
         return
