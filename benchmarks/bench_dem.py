@@ -10,8 +10,9 @@
 (d) ``bonded3d``: 20,000 spheres with ~3 parallel bonds each, uniaxial compression.
 tribodem runs in a fresh process per point (``tribodem bench dem --json``; kernels are
 warmed up before timing). Yade and LIGGGHTS, when installed, run case (a) on the very same
-particles, LIGGGHTS also case (c) (``benchmarks/peers.py``); the script prints tribodem's
-per-thread ratio to each. Prints a markdown table and a JSON list (for BENCHMARKS.md).
+particles, LIGGGHTS also case (c), Yade with JCFpm bonds case (d) (``benchmarks/peers.py``);
+the script prints tribodem's per-thread ratio to each. Prints a markdown table and a JSON
+list (for BENCHMARKS.md).
 """
 
 from __future__ import annotations
@@ -35,7 +36,8 @@ ALL_CASES = {"settle3d": ((20_000, 2000), (2000, 200)),
              "compress2d": ((50_000, 2000), (5000, 200)),
              "dense3d": ((20_000, 2000), (2000, 200)),
              "bonded3d": ((20_000, 2000), (2000, 200))}
-PEER_CASES = {"settle3d": ("yade", "liggghts"), "dense3d": ("liggghts",)}
+PEER_CASES = {"settle3d": ("yade", "liggghts"), "dense3d": ("liggghts",),
+              "bonded3d": ("yade-jcfpm",)}
 
 
 def tribodem_point(case: str, n: int, steps: int, threads: int) -> dict:
@@ -77,7 +79,8 @@ def main(argv: list[str] | None = None) -> list[dict]:
 
         from tribodem.dem import bench_cases
 
-        runners = {"yade": peers.run_yade, "liggghts": peers.run_liggghts}
+        runners = {"yade": peers.run_yade, "liggghts": peers.run_liggghts,
+                   "yade-jcfpm": peers.run_yade_jcfpm}
         with tempfile.TemporaryDirectory(prefix="tribodem_peers_") as tmp:
             for cname, codes in PEER_CASES.items():
                 if cname not in sizes:
