@@ -126,6 +126,24 @@ def main() -> None:
         else:
             typer.echo(f"error: {err}", err=True)
         sys.exit(getattr(err, "exit_code", 2) or 2)
+    except Exception as err:
+        # Ctrl-C inside compiled or C code (numba loading a kernel, for one) can surface as
+        # another exception whose cause is the KeyboardInterrupt: still a Ctrl-C
+        if _interrupt_in_chain(err):
+            interrupted()
+        raise
+
+
+def _interrupt_in_chain(err: BaseException) -> bool:
+    """Whether a KeyboardInterrupt is in ``err``'s chain of causes and contexts."""
+    seen: set[int] = set()
+    e: BaseException | None = err
+    while e is not None and id(e) not in seen:
+        if isinstance(e, KeyboardInterrupt):
+            return True
+        seen.add(id(e))
+        e = e.__cause__ or e.__context__
+    return False
 
 
 if __name__ == "__main__":

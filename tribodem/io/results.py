@@ -10,7 +10,10 @@ import csv
 import io
 import json
 import os
+import re
+import signal
 import tempfile
+import threading
 from collections.abc import Callable, Iterable, Sequence
 from pathlib import Path
 from typing import Any
@@ -35,11 +38,18 @@ def atomic_write(path: str | Path, writer: Callable[[Path], None]) -> Path:
     """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp" + path.suffix,
-                               dir=path.parent)
-    os.close(fd)
-    tmp_path = Path(tmp)
+    # Ctrl-C held off from the temporary's creation until the cleanup below is armed
+    # (a Python signal handler only runs between bytecodes; the pending signal fires after
+    # the unblock, inside the try)
+    held = _block_sigint()
     try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp" + path.suffix,
+                                   dir=path.parent)
+        tmp_path = Path(tmp)
+    finally:
+        _unblock_sigint(held)
+    try:
+        os.close(fd)
         writer(tmp_path)
         os.chmod(tmp_path, _MODE)
         os.replace(tmp_path, path)
@@ -47,6 +57,35 @@ def atomic_write(path: str | Path, writer: Callable[[Path], None]) -> Path:
         if tmp_path.exists():
             tmp_path.unlink()
     return path
+
+
+def _block_sigint() -> bool:
+    if threading.current_thread() is not threading.main_thread():
+        return False
+    signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    return True
+
+
+def _unblock_sigint(held: bool) -> None:
+    if held:
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+
+
+#: the temporaries of :func:`atomic_write`: ``.NAME.XXXXXXXX.tmp[.suffix]``
+_TEMPORARY = re.compile(r"^\..+\.[A-Za-z0-9_]{8}\.tmp(\.[^/]*)?$")
+
+
+def remove_temporaries(folder: str | Path) -> list[Path]:
+    """Delete the temporaries an interrupted :func:`atomic_write` left below ``folder``
+    (a kill -9 between the write and the rename); returns them. Called before a resume."""
+    gone = []
+    root = Path(folder)
+    if root.is_dir():
+        for p in root.rglob(".*.tmp*"):
+            if p.is_file() and _TEMPORARY.match(p.name):
+                p.unlink()
+                gone.append(p)
+    return gone
 
 
 def write_text(path: str | Path, text: str) -> Path:

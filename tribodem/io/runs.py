@@ -78,7 +78,9 @@ def check_out_dir(out: str | Path, field: str = "--out", resume: bool = False,
     """Check an output folder before any work; ``ConfigError`` names ``field`` and the value.
 
     It must be a folder (or not exist yet) in a writable place; nothing is created here.
-    With ``resume``, it must exist and hold the files named in ``need``.
+    With ``resume``, it must exist and hold the files named in ``need``; the temporaries an
+    interrupted atomic write left there (``.NAME.XXXXXXXX.tmp*``, never results) are
+    removed.
     """
     p = Path(out)
     if p.exists() and not p.is_dir():
@@ -92,6 +94,9 @@ def check_out_dir(out: str | Path, field: str = "--out", resume: bool = False,
             if not (p / name).is_file():
                 raise ConfigError(f"{field} = '{p}': --resume needs '{name}' there, and it "
                                   "is missing (was the run started with checkpoints?)")
+        from tribodem.io.results import remove_temporaries
+
+        remove_temporaries(p)
     parent = p
     while not parent.exists():
         parent = parent.parent
