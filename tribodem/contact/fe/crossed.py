@@ -36,10 +36,12 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
+from tribodem.contact.base import ElasticBody, contact_modulus
 from tribodem.contact.fe.ccx import run_ccx
-from tribodem.contact.fe.deck import FEMaterial
+from tribodem.contact.fe.deck import FEMaterial, _fmt, _time_points, _write_ids
 from tribodem.contact.fe.mesh import graded_half, graded_symmetric
-from tribodem.contact.fe.results import read_dat
+from tribodem.contact.fe.results import read_dat, tributary_length
+from tribodem.contact.geometry import HertzSphere
 
 _GP = 1.0 / math.sqrt(3.0)
 #: ccx's 2x2x2 Gauss points of C3D8 in its order (xi fastest, then eta, then zeta)
@@ -48,14 +50,6 @@ GAUSS_2X2X2 = np.array([[a, b, c] for c in (-_GP, _GP) for b in (-_GP, _GP)
 #: natural coordinates of the C3D8 nodes (1-4 at zeta = -1 counter-clockwise, 5-8 above)
 NODE_XI = np.array([[-1, -1, -1], [1, -1, -1], [1, 1, -1], [-1, 1, -1],
                     [-1, -1, 1], [1, -1, 1], [1, 1, 1], [-1, 1, 1]], dtype=float)
-
-
-def hertz_point(load: float, radius: float, e_star: float) -> tuple[float, float]:
-    """Hertz circular contact (Johnson 4.22-4.23): (p0 Pa, a m) for a total load ``load``
-    (N), equivalent radius ``radius`` (m; crossed cylinders of radii R1, R2: sqrt(R1 R2)
-    for equal radii the contact is circular), contact modulus ``e_star`` (Pa)."""
-    a = (3.0 * load * radius / (4.0 * e_star)) ** (1.0 / 3.0)
-    return 3.0 * load / (2.0 * math.pi * a * a), a
 
 
 @dataclass(frozen=True)
@@ -88,13 +82,15 @@ class CrossedCase:
     @property
     def e_star(self) -> float:
         """Contact modulus of two bodies of ``material``, Pa."""
-        m = self.material
-        return m.young / (2.0 * (1.0 - m.poisson**2))
+        body = ElasticBody(self.material.young, self.material.poisson)
+        return contact_modulus(body, body)
 
     @property
     def hertz(self) -> tuple[float, float]:
-        """(p0 Pa, a m) of the case."""
-        return hertz_point(self.load, self.radius, self.e_star)
+        """(p0 Pa, a m) of the case: crossed equal cylinders touch as a sphere of the same
+        radius on a flat (Johnson 4.22-4.23)."""
+        h = HertzSphere(self.radius, self.load, self.e_star)
+        return h.peak_pressure, h.contact_radius
 
 
 @dataclass
@@ -222,15 +218,6 @@ def crossed_mesh(case: CrossedCase) -> Mesh3D:
     return mesh
 
 
-def _fmt(v: float) -> str:
-    return f"{v:.9e}"
-
-
-def _ids(out: io.StringIO, ids: NDArray[np.int64]) -> None:
-    for k in range(0, ids.size, 16):
-        out.write(", ".join(str(int(i)) for i in ids[k:k + 16]) + "\n")
-
-
 def write_crossed_deck(path: str | Path, mesh: Mesh3D, case: CrossedCase) -> Path:
     """The ccx deck (``.inp``): seating, the normal load, and with ``case.delta`` the
     tangential cycle of REF along x (as the 2D deck, :mod:`tribodem.contact.fe.deck`)."""
@@ -248,10 +235,10 @@ def write_crossed_deck(path: str | Path, mesh: Mesh3D, case: CrossedCase) -> Pat
             out.write(f"{k}, " + ", ".join(str(int(v)) for v in c) + "\n")
     for name, ids in mesh.node_sets.items():
         out.write(f"*NSET, NSET={name}\n")
-        _ids(out, ids)
+        _write_ids(out, ids)
     for name in ("UCONT", "LCONT"):
         out.write(f"*ELSET, ELSET={name}\n")
-        _ids(out, mesh.element_sets[name])
+        _write_ids(out, mesh.element_sets[name])
     # faces: C3D8 S1 = nodes 1-2-3-4 (zeta = -1, the upper body's bottom), S2 = 5-8-7-6 (top)
     out.write("*SURFACE, NAME=SUP, TYPE=ELEMENT\nUCONT, S1\n")
     out.write("*SURFACE, NAME=SLOW, TYPE=ELEMENT\nLCONT, S2\n")
@@ -314,12 +301,6 @@ def write_crossed_deck(path: str | Path, mesh: Mesh3D, case: CrossedCase) -> Pat
     path = Path(path)
     path.write_text(out.getvalue())
     return path
-
-
-def _time_points(out: io.StringIO, name: str, times: NDArray[np.float64]) -> None:
-    out.write(f"*TIME POINTS, NAME={name}\n")
-    for k in range(0, times.size, 8):
-        out.write(", ".join(f"{t:.12g}" for t in times[k:k + 8]) + "\n")
 
 
 def surface_forces(mesh: Mesh3D, elems: NDArray[np.int64], stress: NDArray[np.float64]
@@ -388,13 +369,9 @@ class CrossedRun:
 def tributary_area(x: NDArray, y: NDArray, xs: NDArray, ys: NDArray) -> NDArray[np.float64]:
     """Area (m^2) each node of the surface grid ``xs x ys`` stands for (half cells on the
     grid's edges, in particular on the symmetry planes)."""
-    def widths(g: NDArray) -> NDArray:
-        edges = np.concatenate([[g[0]], 0.5 * (g[1:] + g[:-1]), [g[-1]]])
-        return np.diff(edges)
-
     ix = np.searchsorted(xs, x - 1e-9 * np.ptp(xs))
     iy = np.searchsorted(ys, y - 1e-9 * np.ptp(ys))
-    return widths(xs)[ix] * widths(ys)[iy]
+    return tributary_length(xs)[ix] * tributary_length(ys)[iy]
 
 
 def read_crossed(folder: Path, mesh: Mesh3D, case: CrossedCase) -> list[SurfaceState]:
