@@ -132,6 +132,8 @@ CASES: list[tuple[str, list[str], list[str]]] = [
      ["--counts", "abc"]),
     ("study-counts-0", ["fretting", "debris-study", "--out", NEW, "--counts", "0,5"],
      ["--counts", "0,5"]),
+    ("study-counts-memory", ["fretting", "debris-study", "--out", NEW, "--counts", "10000000"],
+     ["--counts", "10000000", "GiB"]),
     ("study-cycle-0", ["fretting", "debris-study", "--out", NEW, "--cycle", "0"],
      ["cycles", "0"]),
     ("study-threads", ["fretting", "debris-study", "--out", NEW, "--threads", "99"],

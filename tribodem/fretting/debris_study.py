@@ -18,6 +18,7 @@ solid-solid part is reported beside it.
 
 from __future__ import annotations
 
+import json
 import math
 from dataclasses import asdict, dataclass
 from pathlib import Path
@@ -26,7 +27,15 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from tribodem.fretting.debris import DebrisField, DebrisSettings, debris_target, run_de_phase
+from tribodem.dem.clumps import debris_template
+from tribodem.dem.state import BYTES_PER_PARTICLE
+from tribodem.fretting.debris import (
+    SHAPES,
+    DebrisField,
+    DebrisSettings,
+    debris_target,
+    run_de_phase,
+)
 from tribodem.fretting.loop import FrettingLoop
 from tribodem.io.results import write_csv, write_figure, write_json, write_npz
 
@@ -186,18 +195,14 @@ TABLE_COLUMNS = (
 
 
 def write_table(out: Path, none: dict[str, Any], rows: list[dict[str, Any]]) -> Path:
-    """``debris_study.csv``: one row without debris, then one per count."""
-    first = {"particles": 0, "active_particles": 0, "debris_load_fraction": 0.0,
-             "total_peak_pressure_Pa": none["peak_pressure_Pa"],
-             "total_peak_pressure_change": 0.0,
-             "solid_peak_pressure_Pa": none["peak_pressure_Pa"],
-             "solid_peak_pressure_change": 0.0, "total_centre_mean_pressure_change": 0.0,
-             "total_edge_mean_pressure_change": 0.0, "total_centre_to_edge":
-             none["centre_to_edge"], "seed_peak_change": None, "servo_rel_error": 0.0,
-             "de_wall_time_s": 0.0}
+    """``debris_study.csv``: one row without debris (its own reference: changes 0), then
+    one per count (rows of :func:`compare`)."""
+    bare = {"particles": 0, "active_particles": 0, "debris_load_fraction": 0.0,
+            "servo_rel_error": 0.0, "de_wall_time_s": 0.0,
+            **{f"{part}_{k}": v for part in ("total", "solid") for k, v in none.items()}}
     return write_csv(out / "debris_study.csv", TABLE_COLUMNS,
                      ([("" if r[k] is None else r[k]) for k in TABLE_COLUMNS]
-                      for r in [first, *rows]))
+                      for r in compare([bare], none) + rows))
 
 
 def write_plots(out: Path, coords: NDArray[np.float64], p_without: NDArray[np.float64],
@@ -276,8 +281,6 @@ def save_count(out: Path, count: int, row: dict[str, Any],
 
 def load_count(out: Path, count: int) -> tuple[dict[str, Any], dict[str, NDArray]] | None:
     """A count finished by an earlier session, or None."""
-    import json
-
     js, npz = out / f"count_{count:06d}.json", out / f"count_{count:06d}.npz"
     if not (js.is_file() and npz.is_file()):
         return None
@@ -331,16 +334,17 @@ def run_debris_study(cfg: Any, out: Path, counts: tuple[int, ...] = SEED_COUNTS,
     out = Path(out)
     wear_dir = out / "wear"
     ck = wear_dir / CHECKPOINT
-    runs.check_out_dir(out, "--out", resume=resume)
+    runs.check_out_dir(out, "--out", resume=resume, need=("study.toml",) if resume else ())
     cfg = cfg.model_copy(update={"debris": cfg.debris.model_copy(update={"every": None})})
+    settings = debris_settings(cfg)
+    spheres_each = sum(share * debris_template(shape, settings.diameter).radii.size
+                       for share, shape in zip(settings.shares, SHAPES, strict=True))
+    for count in counts:  # before any work
+        runs.check_memory(count, spheres_each * BYTES_PER_PARTICLE, "--counts")
     meta = {"config": _jsonable(cfg), "counts": [int(c) for c in counts]}
     if resume:
         old = out / "study.toml"
-        if not old.is_file():
-            raise ConfigError(f"--out = '{out}': --resume needs 'study.toml' there, and it is "
-                              "missing")
-        prev = load_toml(old)
-        if prev != load_toml_roundtrip(meta):
+        if load_toml(old) != load_toml_roundtrip(meta):
             raise ConfigError(f"--resume: the config or counts differ from the study in "
                               f"'{out}' ({old}); allowed: the same config and --counts")
     else:
@@ -363,13 +367,11 @@ def run_debris_study(cfg: Any, out: Path, counts: tuple[int, ...] = SEED_COUNTS,
     p_without, gap = sol.loaded_solution(0.0)
     zones = contact_zones(p_without, sol.coords)
     none = distribution_metrics(p_without, zones, sol.dx)
-    settings = debris_settings(cfg)
     rows: list[dict[str, Any]] = []
     per_count: list[tuple[int, dict[str, NDArray[np.float64]]]] = []
     for k, count in enumerate(counts):
         got = load_count(out, count) if resume else None
         if got is None:
-            runs.check_memory(count * 3, 2500.0, "--counts")
             say(f"stage {k + 2}/{len(counts) + 1}: DE phase with {count:,} debris particles")
             try:
                 row, arrays = run_count(loop, settings, count, p_without, gap, zones)
