@@ -192,6 +192,33 @@ json.dump({"version": yade.config.version, "seconds": seconds, "cpu_seconds": cp
 '''
 
 
+def _run_yade_script(exe: str, wd: Path, params: dict, name: str, template: str,
+                     threads: int, timeout: float) -> tuple[dict, float, list[str]] | None:
+    """Write ``params.json`` and the script ``name`` (``template`` filled with the params
+    path) into ``wd``, run it in Yade on ``threads`` OpenMP threads (log in ``yade.log``),
+    and return (its ``result.json``, the share of CPU other processes took, the command);
+    None, with the reason on stderr, on a timeout or a failure."""
+    (wd / "result.json").unlink(missing_ok=True)
+    (wd / "params.json").write_text(json.dumps(params, indent=1))
+    script = wd / name
+    script.write_text(template % {"params": str(wd / "params.json")})
+    cmd = [exe, "-n", "-j", str(int(threads)), "-x", str(script)]
+    env = dict(os.environ, OMP_NUM_THREADS=str(int(threads)))
+    try:
+        proc, others = _run_measured(cmd, cwd=wd, env=env, capture_output=True, text=True,
+                                     timeout=timeout)
+    except subprocess.TimeoutExpired:
+        print(f"peers: yade timed out after {timeout} s: {' '.join(cmd)}", file=sys.stderr)
+        return None
+    (wd / "yade.log").write_text(proc.stdout + "\n--- stderr ---\n" + proc.stderr)
+    res_file = wd / "result.json"
+    if proc.returncode != 0 or not res_file.exists():
+        print(f"peers: yade failed (rc={proc.returncode}), see {wd / 'yade.log'}:\n"
+              + proc.stderr[-2000:], file=sys.stderr)
+        return None
+    return json.loads(res_file.read_text()), others, cmd
+
+
 def run_yade(case, threads: int, workdir, timeout: float = TIMEOUT_S) -> dict | None:
     """Run ``case`` in Yade with ``threads`` OpenMP threads; None if Yade is not installed."""
     exe = shutil.which("yade")
@@ -213,26 +240,11 @@ def run_yade(case, threads: int, workdir, timeout: float = TIMEOUT_S) -> dict | 
         "verlet_dist": 0.5 * skin_length(case),
         "final": str(wd / "final.txt"), "result": str(wd / "result.json"),
     }
-    for stale in ("result.json", "final.txt"):
-        (wd / stale).unlink(missing_ok=True)
-    (wd / "params.json").write_text(json.dumps(params, indent=1))
-    script = wd / "yade_case.py"
-    script.write_text(_YADE_SCRIPT % {"params": str(wd / "params.json")})
-    cmd = [exe, "-n", "-j", str(int(threads)), "-x", str(script)]
-    env = dict(os.environ, OMP_NUM_THREADS=str(int(threads)))
-    try:
-        proc, others = _run_measured(cmd, cwd=wd, env=env, capture_output=True, text=True,
-                                     timeout=timeout)
-    except subprocess.TimeoutExpired:
-        print(f"peers: yade timed out after {timeout} s: {' '.join(cmd)}", file=sys.stderr)
+    (wd / "final.txt").unlink(missing_ok=True)
+    ran = _run_yade_script(exe, wd, params, "yade_case.py", _YADE_SCRIPT, threads, timeout)
+    if ran is None:
         return None
-    (wd / "yade.log").write_text(proc.stdout + "\n--- stderr ---\n" + proc.stderr)
-    res_file = wd / "result.json"
-    if proc.returncode != 0 or not res_file.exists():
-        print(f"peers: yade failed (rc={proc.returncode}), see {wd / 'yade.log'}:\n"
-              + proc.stderr[-2000:], file=sys.stderr)
-        return None
-    raw = json.loads(res_file.read_text())
+    raw, others, cmd = ran
     if raw["iter"] != case.steps:
         print(f"peers: yade ran {raw['iter']} steps, expected {case.steps}", file=sys.stderr)
     out = {
@@ -331,25 +343,11 @@ def run_yade_jcfpm(case, threads: int, workdir, timeout: float = TIMEOUT_S) -> d
                   "detection_factor": 1.0 + case.bonds["gap"] / (2.0 * r_mean)},
         "result": str(wd / "result.json"),
     }
-    (wd / "result.json").unlink(missing_ok=True)
-    (wd / "params.json").write_text(json.dumps(params, indent=1))
-    script = wd / "yade_jcfpm.py"
-    script.write_text(_YADE_JCFPM_SCRIPT % {"params": str(wd / "params.json")})
-    cmd = [exe, "-n", "-j", str(int(threads)), "-x", str(script)]
-    env = dict(os.environ, OMP_NUM_THREADS=str(int(threads)))
-    try:
-        proc, others = _run_measured(cmd, cwd=wd, env=env, capture_output=True, text=True,
-                                     timeout=timeout)
-    except subprocess.TimeoutExpired:
-        print(f"peers: yade timed out after {timeout} s: {' '.join(cmd)}", file=sys.stderr)
+    ran = _run_yade_script(exe, wd, params, "yade_jcfpm.py", _YADE_JCFPM_SCRIPT, threads,
+                           timeout)
+    if ran is None:
         return None
-    (wd / "yade.log").write_text(proc.stdout + "\n--- stderr ---\n" + proc.stderr)
-    res_file = wd / "result.json"
-    if proc.returncode != 0 or not res_file.exists():
-        print(f"peers: yade failed (rc={proc.returncode}), see {wd / 'yade.log'}:\n"
-              + proc.stderr[-2000:], file=sys.stderr)
-        return None
-    raw = json.loads(res_file.read_text())
+    raw, others, cmd = ran
     return {
         "code": "yade-jcfpm", "version": raw["version"], "case": case.name,
         "particles": case.n, "steps": int(case.steps), "threads": int(raw["threads"]),
