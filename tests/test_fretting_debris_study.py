@@ -87,3 +87,7 @@ def test_debris_study_command(tmp_path: Path) -> None:
     assert r2.returncode == 0, r2.stdout + r2.stderr
     assert "DE phase" not in r2.stdout and "fretting run" not in r2.stdout
     assert (out / "debris_study.csv").read_text() == table
+    # --resume alone takes the study's own config and counts
+    r3 = run_tribodem("fretting", "debris-study", "--out", str(out), "--resume", "--no-progress")
+    assert r3.returncode == 0, r3.stdout + r3.stderr
+    assert "DE phase" not in r3.stdout and (out / "debris_study.csv").read_text() == table

@@ -984,7 +984,8 @@ def debris_study_cmd(
     quick: Annotated[bool, typer.Option("--quick", help="64^2 grid, cycle 10, counts / 20.")
                      ] = False,
     resume: Annotated[bool, typer.Option(
-        "--resume", help="Skip the finished stages of an earlier study in --out.")] = False,
+        "--resume", help="Skip the finished stages of an earlier study in --out (its config "
+        "and counts unless given).")] = False,
     progress: Annotated[bool, typer.Option(
         "--progress/--no-progress", help="Progress bar of the wear run on stderr.")] = True,
 ) -> None:
@@ -995,14 +996,16 @@ def debris_study_cmd(
     from tribodem.fretting.debris_study import SEED_COUNTS, run_debris_study
 
     n_threads = runs.check_threads(threads, "--threads")
-    wanted = parse_counts(counts if counts is not None else (
-        QUICK_STUDY_COUNTS if quick else ",".join(str(c) for c in SEED_COUNTS)))
+    runs.check_out_dir(out, "--out", resume=resume, need=("study.toml",) if resume else ())
+    # a resume takes the study's own config and counts unless they are given again
+    study = load_toml(out / "study.toml", "--out") if resume else {}
+    default = ",".join(str(c) for c in study["counts"]) if resume else \
+        QUICK_STUDY_COUNTS if quick else ",".join(str(c) for c in SEED_COUNTS)
+    wanted = parse_counts(counts if counts is not None else default)
     ov: dict[str, Any] = {}
     if cycle is not None:
         ov["cycles"] = cycle
-    runs.check_out_dir(out, "--out", resume=resume, need=("study.toml",) if resume else ())
-    base = load_toml(out / "study.toml", "--out")["config"] if resume and config is None \
-        else None
+    base = study["config"] if resume and config is None else None
     cfg = resolve_config(config, quick=quick, overrides=ov, base=base)
     numba.set_num_threads(n_threads)
     summary = run_debris_study(cfg, out, wanted, resume=resume, progress=progress,

@@ -352,13 +352,15 @@ def run_debris_study(cfg: Any, out: Path, counts: tuple[int, ...] = SEED_COUNTS,
             stale.unlink()
     out.mkdir(parents=True, exist_ok=True)
     write_text(out / "study.toml", dump_toml(meta))
-    runs.announce(out, ck, resume_hint="add --resume to the same command")
+    hint = "add --resume to the same command"
+    runs.announce(out, ck, resume_hint=hint)
     done_wear = (wear_dir / "summary.json").is_file() and ck.is_file()
     if not (resume and done_wear):
         say(f"stage 1/{len(counts) + 1}: fretting run to cycle {cfg.cycles} without debris "
             f"-> {wear_dir}")
         run_fretting(cfg, wear_dir, echo=echo, resume=resume and ck.is_file(),
                      progress=progress)
+        runs.announce(out, ck, resume_hint=hint)  # the study's folder again, not wear/
     meta_ck, state = read_checkpoint(ck)
     loop = build_loop(cfg)
     loop.load_state_dict(state)
