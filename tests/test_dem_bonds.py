@@ -7,7 +7,13 @@ import numpy as np
 import pytest
 
 from tribodem.dem import Box, Material, ParticleState, Simulation
-from tribodem.dem.bonds import ParallelBonds, bond_forces, install_bonds_by_gap
+from tribodem.dem.bonds import (
+    ParallelBonds,
+    bond_csr,
+    bond_forces,
+    gather_bonds,
+    install_bonds_by_gap,
+)
 from tribodem.dem.state import FIX_ROTATION, FIX_TRANSLATION
 
 R = 1.0e-3  # particle radius (m)
@@ -194,6 +200,8 @@ def test_checkpoint_restores_bonds_and_log(tmp_path) -> None:
 
 
 def test_threaded_and_serial_kernels_agree_bitwise() -> None:
+    """The serial pass sums each bond into its particles (Newton pairs); the threaded one
+    stores the bonds and ``gather_bonds`` adds them in bond order: the same bits."""
     rng = np.random.default_rng(3)
     n, nb = 3000, 5000
     pos = rng.uniform(0, 0.1, (n, 3))
@@ -205,18 +213,24 @@ def test_threaded_and_serial_kernels_agree_bitwise() -> None:
     d = pos[j] - pos[i]
     nrm = d / np.linalg.norm(d, axis=1)[:, None]
     one = np.ones(nb)
+    gstart, gbond = bond_csr(i, j, n, by_bond=True)
     outs = []
-    for build in (bond_forces.serial, bond_forces.parallel):
+    for build, summed in ((bond_forces.serial, True), (bond_forces.parallel, False)):
         arrays = [np.zeros(nb), np.full((nb, 3), 1e-3), np.zeros((nb, 3)), np.zeros(nb),
                   nrm.copy(), np.zeros(nb, np.int8), np.zeros(nb, np.int8),
                   np.zeros((nb, 9)), np.zeros((nb, 3)), np.zeros((nb, 3)), np.zeros((nb, 3))]
+        ext = [np.full((n, 3), 0.25), np.full((n, 3), -0.5)]  # summed onto what is there
         nnew = build(pos, vel, omega, radius, i, j, R * one, 1e-6 * one, 1e-13 * one,
                      2e-13 * one, 5e11 * one, 3e11 * one, 2e3 * one, 3e3 * one, 0.1 * one,
-                     *arrays, 3, 1e-4, np.zeros(3), np.zeros(3, dtype=np.bool_))
-        outs.append((nnew, arrays))
+                     *arrays, 3, 1e-4, np.zeros(3), np.zeros(3, dtype=np.bool_), summed,
+                     *ext)
+        if not summed:
+            gather_bonds.parallel(gstart, gbond, i, arrays[5], *arrays[8:], *ext)
+        outs.append((nnew, arrays[:8] + ext))
     assert 0 < outs[0][0] == outs[1][0] < nb
     for a, b in zip(outs[0][1], outs[1][1], strict=True):
         assert np.array_equal(a, b)
+    assert np.any(outs[0][1][-2] != 0.25)
 
 
 def test_bad_input_is_refused() -> None:

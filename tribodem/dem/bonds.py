@@ -38,7 +38,7 @@ import numpy as np
 from numba import njit, prange
 
 from tribodem.dem import neighbors
-from tribodem.dem.jit import kernel
+from tribodem.dem.jit import kernel, serial_run
 from tribodem.dem.space import min_image
 from tribodem.dem.state import checked_per_item
 
@@ -97,12 +97,18 @@ def _rotate(arr, b, c, k0, k1, k2, cw, sw, ws, n0, n1, n2):
 @kernel(chunk=256)
 def bond_forces(pos, vel, omega, radius, bi, bj, rb, area, ib, jb, kn, ks, tens, coh, tanphi,
                 fn, fs, mb, mt, nrm, mode, newly, brk, fbond, tbi, tbj, dim, dt, length,
-                periodic):
+                periodic, summed, ext_force, ext_torque):
     """Update every intact bond (prange over bonds; each writes only its own rows).
 
     fbond[b]: force on j (i gets minus it); tbi/tbj: moments on i and j (N m). A bond that
     breaks this step gets ``mode`` (1 tensile, 2 shear), ``newly = 1``, its load in
     ``brk`` and zero force. Returns the number of new breaks.
+
+    ``summed`` (serial build only: the loop then writes shared rows): instead of storing
+    ``fbond``/``tbi``/``tbj``, add each intact bond straight into ``ext_force`` /
+    ``ext_torque`` of its two particles (Newton pairs) in increasing bond index -- the
+    order in which ``gather_bonds`` adds them after the threaded pass, so both give the
+    same bits. ``fbond``/``tbi``/``tbj`` are then left as they were.
     """
     nb = bi.shape[0]
     nnew = 0
@@ -128,8 +134,11 @@ def bond_forces(pos, vel, omega, radius, bi, bj, rb, area, ib, jb, kn, ks, tens,
         # mean spin about the normal (3D; zero in 2D)
         ws = 0.5 * ((omega[i, 0] + omega[j, 0]) * n0 + (omega[i, 1] + omega[j, 1]) * n1
                     + (omega[i, 2] + omega[j, 2]) * n2) * dt
-        cw = np.cos(ws)
-        sw = np.sin(ws)
+        cw = 1.0
+        sw = 0.0
+        if ws != 0.0:  # always zero in 2D: _rotate skips the spin then
+            cw = np.cos(ws)
+            sw = np.sin(ws)
         _rotate(fs, b, c, k0, k1, k2, cw, sw, ws, n0, n1, n2)
         _rotate(mb, b, c, k0, k1, k2, cw, sw, ws, n0, n1, n2)
         nrm[b, 0] = n0
@@ -191,16 +200,14 @@ def bond_forces(pos, vel, omega, radius, bi, bj, rb, area, ib, jb, kn, ks, tens,
             for k in range(3):
                 fs[b, k] = 0.0
                 mb[b, k] = 0.0
-                fbond[b, k] = 0.0
-                tbi[b, k] = 0.0
-                tbj[b, k] = 0.0
+                if not summed:
+                    fbond[b, k] = 0.0
+                    tbi[b, k] = 0.0
+                    tbj[b, k] = 0.0
             continue
         f0 = fn[b] * n0 + fs[b, 0]
         f1 = fn[b] * n1 + fs[b, 1]
         f2 = fn[b] * n2 + fs[b, 2]
-        fbond[b, 0] = f0
-        fbond[b, 1] = f1
-        fbond[b, 2] = f2
         # arm x force: j arm -aj n with F; i arm ai n with -F
         cx = n1 * f2 - n2 * f1
         cy = n2 * f0 - n0 * f2
@@ -208,6 +215,23 @@ def bond_forces(pos, vel, omega, radius, bi, bj, rb, area, ib, jb, kn, ks, tens,
         m0 = mb[b, 0] + mt[b] * n0
         m1 = mb[b, 1] + mt[b] * n1
         m2 = mb[b, 2] + mt[b] * n2
+        if summed:
+            ext_force[i, 0] -= f0
+            ext_force[i, 1] -= f1
+            ext_force[i, 2] -= f2
+            ext_torque[i, 0] += -ai * cx - m0
+            ext_torque[i, 1] += -ai * cy - m1
+            ext_torque[i, 2] += -ai * cz - m2
+            ext_force[j, 0] += f0
+            ext_force[j, 1] += f1
+            ext_force[j, 2] += f2
+            ext_torque[j, 0] += -aj * cx + m0
+            ext_torque[j, 1] += -aj * cy + m1
+            ext_torque[j, 2] += -aj * cz + m2
+            continue
+        fbond[b, 0] = f0
+        fbond[b, 1] = f1
+        fbond[b, 2] = f2
         tbj[b, 0] = -aj * cx + m0
         tbj[b, 1] = -aj * cy + m1
         tbj[b, 2] = -aj * cz + m2
@@ -218,12 +242,19 @@ def bond_forces(pos, vel, omega, radius, bi, bj, rb, area, ib, jb, kn, ks, tens,
 
 
 @kernel
-def gather_bonds(cstart, cbond, bi, fbond, tbi, tbj, ext_force, ext_torque):
-    """Add bond forces/moments to each particle (prange over particles, fixed order)."""
+def gather_bonds(cstart, cbond, bi, mode, fbond, tbi, tbj, ext_force, ext_torque):
+    """Add bond forces/moments to each particle (prange over particles, fixed order).
+
+    ``cbond[cstart[p]:cstart[p+1]]`` lists p's bonds in increasing bond index
+    (``bond_csr(..., by_bond=True)``): the order of the serial ``bond_forces(summed=True)``.
+    Broken bonds add nothing (as there).
+    """
     n = cstart.shape[0] - 1
     for p in prange(n):
         for q in range(cstart[p], cstart[p + 1]):
             b = cbond[q]
+            if mode[b] != INTACT:
+                continue
             if bi[b] == p:
                 for k in range(3):
                     ext_force[p, k] -= fbond[b, k]
@@ -234,11 +265,13 @@ def gather_bonds(cstart, cbond, bi, fbond, tbi, tbj, ext_force, ext_torque):
                     ext_torque[p, k] += tbj[b, k]
 
 
-def bond_csr(bi: np.ndarray, bj: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
-    """Per-particle bond index (CSR): ``cbond[cstart[p]:cstart[p+1]]`` are p's bonds."""
+def bond_csr(bi: np.ndarray, bj: np.ndarray, n: int, by_bond: bool = False
+             ) -> tuple[np.ndarray, np.ndarray]:
+    """Per-particle bond index (CSR): ``cbond[cstart[p]:cstart[p+1]]`` are p's bonds: the
+    bonds where p is i, then those where it is j (``by_bond``: in increasing bond index)."""
     ends = np.concatenate([bi, bj])
     ids = np.concatenate([np.arange(bi.size), np.arange(bj.size)]).astype(np.int64)
-    order = np.argsort(ends, kind="stable")
+    order = np.lexsort((ids, ends)) if by_bond else np.argsort(ends, kind="stable")
     cstart = np.zeros(n + 1, dtype=np.int64)
     np.cumsum(np.bincount(ends, minlength=n), out=cstart[1:])
     return cstart, ids[order]
@@ -321,6 +354,7 @@ class ParallelBonds:
         self.tbj = np.zeros((nb, 3))
         self.log: list[BondBreak] = []
         self.cstart, self.cbond = bond_csr(self.i, self.j, p.n)
+        self.gstart, self.gbond = bond_csr(self.i, self.j, p.n, by_bond=True)
 
     # ------------------------------------------------------------------ interaction
     @property
@@ -338,16 +372,20 @@ class ParallelBonds:
         if self.n_bonds == 0:
             return
         p = sim.p
-        nnew = bond_forces.pick(self.n_bonds)(
+        threads = sim._threads
+        summed = serial_run(self.n_bonds, threads)
+        nnew = bond_forces.pick(self.n_bonds, threads)(
             p.pos, p.vel, p.omega, p.radius, self.i, self.j, self.rb, self.area, self.inertia,
             self.polar, self.kn, self.ks, self.tensile, self.cohesion, self.tan_phi, self.fn,
             self.fs, self.mb, self.mt, self.normal, self.mode, self.newly, self.brk,
             self.fbond, self.tbi, self.tbj, self.dim, sim.dt, sim.box.length,
-            sim.box.periodic)
+            sim.box.periodic, summed, sim.ext_force, sim.ext_torque)
         if nnew:
             self._log_breaks(sim)
-        gather_bonds.pick(p.n)(self.cstart, self.cbond, self.i, self.fbond, self.tbi,
-                               self.tbj, sim.ext_force, sim.ext_torque)
+        if not summed:  # threaded: each bond stored, gathered per particle in bond order
+            gather_bonds.pick(p.n, threads)(self.gstart, self.gbond, self.i, self.mode,
+                                            self.fbond, self.tbi, self.tbj, sim.ext_force,
+                                            sim.ext_torque)
 
     def _log_breaks(self, sim: Simulation) -> None:
         # the kernel runs before the step counter advances: the break belongs to step + 1
@@ -434,6 +472,7 @@ class ParallelBonds:
         self.newly = np.zeros(nb, dtype=np.int8)
         self.brk = np.zeros((nb, N_BREAK))
         self.cstart, self.cbond = bond_csr(self.i, self.j, self.n_particles)
+        self.gstart, self.gbond = bond_csr(self.i, self.j, self.n_particles, by_bond=True)
         self.log = []
         for q in range(state["log_step"].size):
             f = {k: float(state[f"log_{k}"][q]) for k in self._LOG_F}
