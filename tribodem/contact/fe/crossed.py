@@ -151,9 +151,19 @@ def _block(xs: NDArray, ys: NDArray, zeta: NDArray, zmap) -> tuple[NDArray, NDAr
     return nodes, conn.astype(np.int64)
 
 
-def crossed_mesh(case: CrossedCase) -> Mesh3D:
-    """The quarter mesh of :class:`CrossedCase` (see the module docstring)."""
-    _, a = case.hertz
+def crossed_mesh(case: CrossedCase, a: float | None = None, shift_lower: float = 0.0
+                 ) -> Mesh3D:
+    """The quarter (half, with ``case.delta``) mesh of :class:`CrossedCase` (see the module
+    docstring); ``a`` (m): the Hertz radius the mesh is sized on (None: ``case.hertz``, both
+    bodies of ``case.material``). ``info`` holds the grid: ``nx``, ``ny``, ``nz`` (node
+    layers per body) and ``fine_layers`` (node layers of the fine section below the
+    surface, the deepest one included in the fretting backend's column morphing).
+    ``shift_lower`` (m): the lower body's grid is translated by it along x (its cylinder's
+    axis, so its surface is unchanged): with half an element the upper body's surface nodes
+    no longer sit over the lower body's nodes (node-to-surface contact then converges,
+    docs/fe3d.md)."""
+    if a is None:
+        _, a = case.hertz
     h = case.h_fine or a / 6.0
     R = case.radius
     L = case.size_factor * a
@@ -176,7 +186,7 @@ def crossed_mesh(case: CrossedCase) -> Mesh3D:
         s = R - np.sqrt(R * R - x * x)
         return zeta + (1.0 - zeta / L) * s  # zeta = 0 -> s(x); zeta = L -> L
 
-    nl, cl = _block(xs, ys, zl, lower_z)
+    nl, cl = _block(xs + shift_lower, ys, zl, lower_z)
     nu, cu = _block(xs, ys, depth, upper_z)
     off = nl.shape[0]
     nodes = np.vstack([nl, nu])
@@ -207,13 +217,16 @@ def crossed_mesh(case: CrossedCase) -> Mesh3D:
     esets = {
         "LOWER": el[:n_low], "UPPER": el[n_low:],
         "UCONT": bot_u[np.hypot(cen[bot_u - 1, 0], cen[bot_u - 1, 1]) < fine + 2 * a],
-        "LCONT": top_l[np.hypot(np.maximum(np.abs(cen[top_l - 1, 0]) - case.delta, 0.0),
+        "LCONT": top_l[np.hypot(np.maximum(np.abs(cen[top_l - 1, 0] - shift_lower)
+                                           - case.delta, 0.0),
                                 cen[top_l - 1, 1]) < reach],
     }
     mesh = Mesh3D(nodes=nodes, elements=elements, n_lower=n_low, node_sets=sets,
                   element_sets=esets, h_fine=h,
                   info={"a": a, "radius": R, "extent": L, "fine": fine,
-                        "elements": float(elements.shape[0]), "nodes": float(nodes.shape[0])})
+                        "elements": float(elements.shape[0]), "nodes": float(nodes.shape[0]),
+                        "nx": float(nx), "ny": float(ys.size), "nz": float(depth.size),
+                        "fine_layers": float(math.ceil(fine / h - 1e-9))})
     mesh.check()
     return mesh
 
@@ -303,27 +316,37 @@ def write_crossed_deck(path: str | Path, mesh: Mesh3D, case: CrossedCase) -> Pat
     return path
 
 
+def element_forces(x: NDArray[np.float64], stress: NDArray[np.float64]
+                   ) -> NDArray[np.float64]:
+    """Element nodal forces f = sum_gp B^T sigma det(J) w (N; small strain, exact for the
+    ccx solution up to the printed digits) of C3D8 elements with node coordinates ``x``
+    [m, 8, 3] and Gauss-point stresses ``stress`` [m, 8, 6] in ccx order (xx, yy, zz, xy,
+    xz, yz) -> [m, 8, 3]. At a free surface node the sum over its elements is the external
+    (contact) force on it."""
+    sig = np.empty(stress.shape[:2] + (3, 3))
+    for (i, j), c in (((0, 0), 0), ((1, 1), 1), ((2, 2), 2), ((0, 1), 3), ((0, 2), 4),
+                      ((1, 2), 5)):
+        sig[..., i, j] = sig[..., j, i] = stress[..., c]
+    f = np.zeros(x.shape)
+    for g, xi in enumerate(GAUSS_2X2X2):
+        dn = _dshape(xi)  # [8, 3]
+        jac = np.einsum("mki,kj->mij", x, dn)  # d x_i / d xi_j
+        grad = np.einsum("kj,mji->mki", dn, np.linalg.inv(jac))  # d N_k / d x_i
+        f += np.einsum("mki,mil->mkl", grad, sig[:, g]) * np.linalg.det(jac)[:, None, None]
+    return f
+
+
 def surface_forces(mesh: Mesh3D, elems: NDArray[np.int64], stress: NDArray[np.float64]
                    ) -> dict[int, NDArray[np.float64]]:
-    """Nodal forces (N) the contact layer's stresses put on its surface nodes: for each
-    element f = sum_gp B^T sigma det(J) w; ``stress`` [n_elem, 8, 6] in ccx order
-    (xx, yy, zz, xy, xz, yz). Returns {node id (1-based): force [3]} for the bottom nodes."""
-    forces: dict[int, NDArray[np.float64]] = {}
-    for e, s in zip(elems, stress, strict=True):
-        conn = mesh.elements[int(e) - 1]
-        x = mesh.nodes[conn]
-        f = np.zeros((8, 3))
-        for g, sv in zip(GAUSS_2X2X2, s, strict=True):
-            dn = _dshape(g)
-            jac = x.T @ dn  # [3, 3]: d x_i / d xi_j
-            grad = dn @ np.linalg.inv(jac)  # [8, 3]: d N / d x
-            sig = np.array([[sv[0], sv[3], sv[4]], [sv[3], sv[1], sv[5]],
-                            [sv[4], sv[5], sv[2]]])
-            f += grad @ sig * np.linalg.det(jac)
-        for local in range(4):  # the bottom face (nodes 1-4) is the contact surface
-            nid = int(conn[local]) + 1
-            forces[nid] = forces.get(nid, np.zeros(3)) + f[local]
-    return forces
+    """Nodal forces (N) the contact layer's stresses put on its surface nodes
+    (:func:`element_forces`); ``stress`` [n_elem, 8, 6] in ccx order (xx, yy, zz, xy, xz,
+    yz). Returns {node id (1-based): force [3]} for the bottom nodes (local 1-4)."""
+    conn = mesh.elements[np.asarray(elems, dtype=np.int64) - 1]
+    f = element_forces(mesh.nodes[conn], stress)
+    total = np.zeros((mesh.nodes.shape[0], 3))
+    np.add.at(total, conn[:, :4], f[:, :4])
+    ids = np.unique(conn[:, :4])
+    return {int(i) + 1: total[i] for i in ids}
 
 
 @dataclass

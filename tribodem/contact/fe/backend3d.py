@@ -1,0 +1,925 @@
+"""``fe3d``: the 3D CalculiX crossed-cylinder first body behind the contract (docs/fe3d.md).
+
+The seed's geometry (seed 003 figure 3.4): two crossed cylinders of equal radius R, the upper
+one's axis along y, the lower one's along x, the stroke along x (a point contact). The mesh is
+:func:`tribodem.contact.fe.crossed.crossed_mesh`'s *half* model (y >= 0, symmetry u_y = 0 on
+y = 0; the stroke breaks the x = 0 symmetry): 8-node bricks on straight vertical node columns
+over one (x, y) grid shared by both bodies, the fine zone covering the stroke along x.
+
+Mode ``fresh`` (the seed's way, section 3.3), as the 2D backend
+(:class:`tribodem.contact.fe.backend.FEContactSolver`): every fretting cycle is one ccx job on
+the current worn geometry, virgin unloaded bodies: seating, the normal load (P / 2 on the half
+model's reference node), then the cycle 0 -> +A -> 0 -> -A -> 0 with **one step per monotonic
+quarter** and **node-to-surface** contact declared once in the model data
+(:func:`tribodem.contact.fe.deck.sliding_contact`: the n2s large-clearance tension 1e-5 p0;
+surface-to-surface friction is wrong on return strokes once the slide crosses elements,
+docs/fe.md "Reversals").
+
+Worn geometry (seed eqs 3.7-3.8): the worn depth of each body at each node column (i, j) is
+its recession (from :meth:`set_surfaces`) minus the unworn one (the constructor's), at the
+column's (x, y) (upper: its own frame, over the window; lower: lab frame, over the window plus
+the stroke); the surface node moves into its body by that depth and the fine-section nodes
+below it are redistributed proportionally (x, y unchanged, :func:`morph_columns3d`);
+:meth:`FE3DContactSolver.worn_volume` is the exact volume lost by the morphed hexahedra.
+
+Fields on the contract's ``n x n`` window (the upper body's frame, base.py), the half model
+mirrored to y < 0 (pressure, x traction and x slip even in y; y traction and y slip odd):
+
+* ``pressure``, ``traction``: the contact force on each surface node of the upper body,
+  recovered from its contact layer's Gauss-point stresses
+  (:func:`tribodem.contact.fe.crossed.element_forces`), over the node's tributary area;
+  mapped to the window cells by exact cell averages of their bilinear interpolant (the
+  window integral equals the nodal force sum). ``traction`` acts on the **upper** body;
+* ``slip``: for each upper surface node, its (x, y) displacement increment minus that of
+  the lower body's material point under it at the start of the increment (bilinear over the
+  lower surface grid), interpolated bilinearly to the window points inside the contact;
+* ``stick``: contact points whose slip increment is at most mu p / k_t (k_t the stick slope).
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import math
+import tempfile
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from tribodem.contact.base import (
+    BODIES,
+    Body,
+    Capabilities,
+    ElasticBody,
+    FirstBodySolver,
+    IncrementResult,
+    Recession,
+    SubsurfaceStress,
+    WindowTooSmallError,
+    _check_positive,
+    contact_modulus,
+    cycle_offsets,
+)
+from tribodem.contact.fe.backend import MODES, cell_average
+from tribodem.contact.fe.ccx import (
+    CcxConvergenceError,
+    CcxRun,
+    FESolverStopped,
+    find_ccx,
+    run_ccx,
+)
+from tribodem.contact.fe.crossed import (
+    GAUSS_2X2X2,
+    NODE_XI,
+    CrossedCase,
+    Mesh3D,
+    _dshape,
+    crossed_mesh,
+    element_forces,
+    tributary_area,
+)
+from tribodem.contact.fe.deck import (
+    ContactSettings,
+    FEMaterial,
+    _fmt,
+    _time_points,
+    _write_ids,
+    sliding_contact,
+)
+from tribodem.contact.fe.results import DatBlock, read_dat
+from tribodem.contact.geometry import HertzSphere, crossed_cylinders
+from tribodem.contact.halfspace import max_shear, von_mises
+
+#: default element size at the contact / Hertz radius of the 3D backend (a/3: Hertz p0 and
+#: a within 3 % on the window, docs/fe3d.md; a/4 costs about 2.5x more per cycle)
+FRETTING3D_H_OVER_A = 1.0 / 3.0
+#: default bodies' extent / Hertz radius (x and y half-extent and height of each body)
+FRETTING3D_SIZE_FACTOR = 8.0
+#: element growth outside the fine zone
+FRETTING3D_GROWTH = 1.4
+
+#: trilinear shape functions of the C3D8 nodes at its 2x2x2 Gauss points, [8 gp, 8 nodes];
+#: its inverse extrapolates Gauss-point values to the nodes
+_N_AT_GP = np.prod(1.0 + GAUSS_2X2X2[:, None, :] * NODE_XI[None, :, :], axis=2) / 8.0
+_EXTRAPOLATE3 = np.linalg.inv(_N_AT_GP)
+
+
+def _curvatures(f: Recession, h: float = 10e-6) -> tuple[float, float]:
+    """(d^2 f / dx^2, d^2 f / dy^2) at the origin by central differences, 1/m."""
+    x = np.array([-h, 0.0, h, 0.0, 0.0])
+    y = np.array([0.0, 0.0, 0.0, -h, h])
+    v = np.asarray(f(x, y), dtype=float)
+    return float((v[0] - 2 * v[1] + v[2]) / h**2), float((v[3] - 2 * v[1] + v[4]) / h**2)
+
+
+def hex_volumes(nodes: NDArray[np.float64], elements: NDArray[np.int64]) -> NDArray[np.float64]:
+    """Volumes (m^3) of C3D8 elements by the 2x2x2 Gauss rule (exact for hexahedra with
+    vertical straight edges over rectangles, the det J being bilinear in (xi, eta) there)."""
+    x = nodes[elements]
+    vol = np.zeros(elements.shape[0])
+    for xi in GAUSS_2X2X2:
+        vol += np.linalg.det(np.einsum("mki,kj->mij", x, _dshape(xi)))
+    return vol
+
+
+def mesh_columns(mesh: Mesh3D) -> dict[str, NDArray[np.int64]]:
+    """Node rows (0-based) of the straight vertical columns of both bodies of a
+    :func:`crossed_mesh`: {body: [ny, nx, nz]}, index 0 on the contact surface."""
+    nx, ny, nz = (int(mesh.info[k]) for k in ("nx", "ny", "nz"))
+    layer = nx * ny
+    lower = np.arange(nz * layer).reshape(nz, ny, nx)[::-1].transpose(1, 2, 0)
+    upper = (nz * layer + np.arange(nz * layer)).reshape(nz, ny, nx).transpose(1, 2, 0)
+    return {"lower": lower, "upper": upper}
+
+
+def morph_columns3d(mesh: Mesh3D, body: str, wear: NDArray[np.float64]) -> Mesh3D:
+    """A copy of ``mesh`` with the surface of ``body`` receded by ``wear`` (m, [ny, nx], one
+    depth per column (j, i), >= 0) by node-column morphing (seed eqs 3.7-3.8): the surface
+    node moves along its vertical column into the body by dW, the fine-section nodes below
+    it down to the fine section's bottom node z_b (fixed; H below the surface) move by
+    z_i = z_b + m (z_i - z_b), m = (H - dW) / H; x and y never change. ``ValueError`` when a
+    depth reaches H (the fine section would invert)."""
+    cols = mesh_columns(mesh)[body]
+    wear = np.asarray(wear, dtype=float)
+    if wear.shape != cols.shape[:2]:
+        raise ValueError(f"wear has shape {wear.shape}: expected {cols.shape[:2]} (ny, nx)")
+    if np.any(wear < 0) or not np.all(np.isfinite(wear)):
+        raise ValueError("wear depths must be finite and >= 0 (m)")
+    k = int(mesh.info["fine_layers"])
+    nodes = mesh.nodes.copy()
+    fine = cols[..., :k + 1]
+    z = nodes[fine, 2]
+    zb = z[..., -1:]
+    height = np.abs(z[..., :1] - zb)
+    if np.any(wear >= height[..., 0]):
+        j, i = np.unravel_index(int(np.argmax(wear / height[..., 0])), wear.shape)
+        raise ValueError(f"worn depth {wear[j, i]:.4g} m at (x, y) = "
+                         f"({nodes[cols[j, i, 0], 0]:.4g}, {nodes[cols[j, i, 0], 1]:.4g}) m "
+                         f"reaches the fine section's depth H = {height[j, i, 0]:.4g} m of the "
+                         f"{body} body: the mesh cannot be morphed further")
+    nodes[fine, 2] = zb + (height - wear[..., None]) / height * (z - zb)  # eqs 3.7-3.8
+    out = Mesh3D(nodes=nodes, elements=mesh.elements, n_lower=mesh.n_lower,
+                 node_sets=mesh.node_sets, element_sets=mesh.element_sets,
+                 h_fine=mesh.h_fine, info=dict(mesh.info))
+    out.check()
+    return out
+
+
+def _grid(mesh: Mesh3D, body: str) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """The (xs, ys) of a body's column grid (ys >= 0, the half model), m."""
+    surf = mesh.nodes[mesh_columns(mesh)[body][..., 0]]
+    return surf[0, :, 0].copy(), surf[:, 0, 1].copy()
+
+
+def _mirror(a: NDArray[np.float64], sign: float = 1.0) -> NDArray[np.float64]:
+    """A half-model field [ny, ...] (y >= 0, row 0 on y = 0) on the full grid [2 ny - 1, ...]
+    (``sign`` -1 for a component odd in y)."""
+    return np.concatenate([sign * a[:0:-1], a], axis=0)
+
+
+def _bilinear(xs: NDArray[np.float64], ys: NDArray[np.float64], f: NDArray[np.float64],
+              x: NDArray[np.float64], y: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Bilinear interpolation of ``f`` [ny, nx, ...] on the sorted grid (xs, ys) at the points
+    (x, y) (clamped to the grid), [n_points, ...]."""
+    i = np.clip(np.searchsorted(xs, x, side="right") - 1, 0, xs.size - 2)
+    j = np.clip(np.searchsorted(ys, y, side="right") - 1, 0, ys.size - 2)
+    tx = np.clip((x - xs[i]) / (xs[i + 1] - xs[i]), 0.0, 1.0)
+    ty = np.clip((y - ys[j]) / (ys[j + 1] - ys[j]), 0.0, 1.0)
+    ex = tuple([slice(None)] + [None] * (f.ndim - 2))
+    tx, ty = tx[ex], ty[ex]
+    return ((1 - ty) * ((1 - tx) * f[j, i] + tx * f[j, i + 1])
+            + ty * ((1 - tx) * f[j + 1, i] + tx * f[j + 1, i + 1]))
+
+
+def _operator(xn: NDArray[np.float64], centres: NDArray[np.float64], dx: float,
+              average: bool) -> NDArray[np.float64]:
+    """Linear map [n_centres, n_nodes] from nodal values on ``xn`` to the window: exact cell
+    averages of the piecewise-linear interpolant (``average``) or its point values."""
+    eye = np.eye(xn.size)
+    if average:
+        return np.stack([cell_average(xn, e, centres, dx) for e in eye], axis=1)
+    return np.stack([np.interp(centres, xn, e, left=0.0, right=0.0) for e in eye], axis=1)
+
+
+@dataclass
+class JobRecord3D:
+    """One ccx job of the 3D backend: where, what it cost (s) and what it gave."""
+
+    cycle: int  #: the fretting cycle it serves (1-based)
+    folder: Path
+    deck: Path
+    elements: int
+    refine: int  #: increment refinement of the successful attempt (1: none)
+    seconds_mesh: float  #: meshing, morphing and deck writing, s
+    seconds_ccx: float  #: ccx wall clock (all attempts), s
+    seconds_read: float  #: reading the .dat and recovering the tractions, s
+    seconds_map: float = 0.0  #: mapping the fields to the window, s
+    worn_volume_upper: float = 0.0  #: worn volume of the morphed upper body, m^3
+    worn_volume_lower: float = 0.0  #: worn volume of the morphed lower body, m^3
+
+
+class FE3DContactSolver(FirstBodySolver):
+    """3D CalculiX crossed-cylinder first body, half model (see the module docstring).
+
+    ``upper``/``lower``: recessions (m) of a cylinder with its axis along y and one with its
+    axis along x, of equal radius R (read from their curvatures at the origin; default the
+    seed's R = 4 mm). ``load``: normal load, N; ``friction``: Coulomb mu; ``n``, ``window``
+    (m; None: ``window_radii`` Hertz radii); ``amplitude`` (m) and ``n_increments`` of the
+    loop's cycle (the job's output times); ``h_over_a`` (element size at the contact / Hertz
+    radius a), ``size_factor`` (bodies' extent / a, at most R / (2 a)) and ``growth`` of the
+    mesh; ``stress_depth`` (m): how deep the column stresses are printed (None: 4.5 a, 1.5 x
+    the threshold criteria's default grid depth 3 a); ``threads``, ``timeout`` (s per ccx
+    job), ``retries`` (after a non-convergence each retry halves the largest increment);
+    ``workdir``: the jobs' folder (``cycle_0001/`` ...; None: a new temporary folder).
+    ``regime`` and ``tolerance`` are the half-space's options and are not used.
+    """
+
+    capabilities = Capabilities(partial_slip=True, subsurface=True, contacts=("point",))
+    #: ccx SMALL SLIDING (pair slave nodes and master faces once per increment): off, the
+    #: loading diverged with it (measured, docs/fe3d.md); the lower grid is shifted by h/2
+    #: along x instead, so no slave node sits on a master node
+    small_sliding: bool = False
+
+    def __init__(
+        self,
+        upper: Recession | None = None,
+        lower: Recession | None = None,
+        load: float = 100.0,
+        friction: float = 0.6,
+        upper_material: ElasticBody | None = None,
+        lower_material: ElasticBody | None = None,
+        n: int = 64,
+        window: float | None = None,
+        window_radii: float = 10.0,
+        contact: str = "point",
+        amplitude: float = 25e-6,
+        n_increments: int = 8,
+        mode: str = "fresh",
+        h_over_a: float = FRETTING3D_H_OVER_A,
+        size_factor: float = FRETTING3D_SIZE_FACTOR,
+        growth: float = FRETTING3D_GROWTH,
+        threads: int = 1,
+        timeout: float = 1800.0,
+        retries: int = 1,
+        workdir: str | Path | None = None,
+        executable: str = "ccx",
+        stress_depth: float | None = None,
+        regime: str = "gross",
+        tolerance: float | None = None,
+    ) -> None:
+        del regime, tolerance  # half-space options (see the class docstring)
+        if (upper is None) != (lower is None):
+            raise ValueError("upper and lower must both be given or both be None (defaults)")
+        if upper is None or lower is None:
+            upper, lower = crossed_cylinders()
+        if contact != "point":
+            raise ValueError(f"contact = {contact!r} is not allowed: the fe3d backend solves "
+                             "crossed cylinders (a point contact); allowed: 'point'")
+        if mode not in MODES:
+            raise ValueError(f"mode = {mode!r} is not allowed: allowed: {', '.join(MODES)}")
+        self.mode = mode
+        self.executable = find_ccx(executable)
+        self.upper, self.lower = upper, lower
+        self._base_upper, self._base_lower = upper, lower
+        self.friction = _check_positive("friction", friction, allow_zero=True)
+        self.upper_material = upper_material or ElasticBody()
+        self.lower_material = lower_material or ElasticBody()
+        self.modulus = contact_modulus(self.upper_material, self.lower_material)
+        if int(n) != n or n < 16 or n % 2:
+            raise ValueError(f"n = {n!r} is not allowed: must be an even integer >= 16")
+        self.n = int(n)
+        self.contact = "point"
+        ux, uy = _curvatures(upper)
+        lx, ly = _curvatures(lower)
+        if not (ux > 0 and ly > 0) or abs(uy) > 1e-6 * ux or abs(lx) > 1e-6 * ly:
+            raise ValueError(
+                "the fe3d backend models crossed cylinders: the upper body curved along x only "
+                f"(axis along y) and the lower along y only (axis along x); got curvatures "
+                f"upper ({ux:.3g}, {uy:.3g}), lower ({lx:.3g}, {ly:.3g}) 1/m")
+        if abs(ux / ly - 1.0) > 1e-3:
+            raise ValueError(f"the fe3d backend models cylinders of equal radius; got R = "
+                             f"{1 / ux:.4g} and {1 / ly:.4g} m")
+        self.radius = 2.0 / (ux + ly)
+        self.load = _check_positive("load", load)
+        hz = HertzSphere(self.radius, self.load, self.modulus)
+        a = hz.contact_radius
+        if window is None:
+            window = _check_positive("window_radii", window_radii) * a
+        self.dx = _check_positive("window", window) / self.n
+        self.amplitude = _check_positive("amplitude", amplitude)
+        self.offsets = cycle_offsets(self.amplitude, n_increments)
+        self.n_increments = int(n_increments)
+        self.h_over_a = _check_positive("h_over_a", h_over_a)
+        self.size_factor = _check_positive("size_factor", size_factor)
+        if self.size_factor * a > 0.5 * self.radius:
+            raise ValueError(f"size_factor = {size_factor!r} is not allowed: the bodies' extent "
+                             f"size_factor x a = {self.size_factor * a:.4g} m must not exceed "
+                             f"R / 2 = {0.5 * self.radius:.4g} m (allowed: <= "
+                             f"{0.5 * self.radius / a:.3g})")
+        self.growth = float(growth)
+        if int(threads) != threads or threads < 1:
+            raise ValueError(f"threads = {threads!r} is not allowed: an integer >= 1")
+        self.threads = int(threads)
+        self.timeout = _check_positive("timeout", timeout)
+        if int(retries) != retries or retries < 0:
+            raise ValueError(f"retries = {retries!r} is not allowed: an integer >= 0")
+        self.retries = int(retries)
+        self.workdir: Path | None = None if workdir is None else Path(workdir)
+        self.stress_depth = (_check_positive("stress_depth", stress_depth)
+                             if stress_depth is not None else 4.5 * a)
+        #: node-to-surface, pair declared once, n2s tension 1e-5 p0 (docs/fe.md "Reversals")
+        self.settings: ContactSettings = sliding_contact(self.friction, hz.peak_pressure)
+        self.jobs: list[JobRecord3D] = []  #: every ccx job run, in order
+        self._mesh0 = self._base_mesh()
+        self._cols = mesh_columns(self._mesh0)
+        self._grids = {b: _grid(self._mesh0, b) for b in BODIES}
+        self._xs, self._ys = self._grids["upper"]
+        self._xl = self._grids["lower"][0]
+        self._ys_full = _mirror(self._ys, -1.0)
+        c = self.coords
+        if self._xs[-1] < c[-1] or self._ys[-1] < c[-1]:
+            raise ValueError(f"the window (side {self.window:.4g} m) is wider than the mesh "
+                             f"(half-extent {self._ys[-1]:.4g} m): raise size_factor or give "
+                             "a smaller window")
+        self._avg_x = _operator(self._xs, c, self.dx, True)
+        self._avg_y = _operator(self._ys_full, c, self.dx, True)
+        self._pt_x = _operator(self._xs, c, self.dx, False)
+        self._pt_y = _operator(self._ys_full, c, self.dx, False)
+        self._areas = {b: tributary_area(*np.meshgrid(xs, ys), xs, ys)
+                       for b, (xs, ys) in self._grids.items()}
+        self._area = self._areas["upper"]
+        # the upper surface nodes all of whose bottom-layer elements are in UCONT (the
+        # tractions are recovered there; elsewhere the element sums are incomplete)
+        m0 = self._mesh0
+        n_cell = (self._xs.size - 1) * (self._ys.size - 1)
+        bottom = m0.elements[m0.n_lower:m0.n_lower + n_cell, :4]
+        ucont = m0.elements[m0.element_sets["UCONT"] - 1, :4]
+        count = np.zeros(m0.nodes.shape[0])
+        np.add.at(count, bottom, 1.0)
+        np.add.at(count, ucont, -1.0)
+        self._complete = count[self._cols["upper"][..., 0]] == 0.0
+        self.reset()
+        self._cycle = 0
+        self._job_key: tuple[bytes, bytes] | None = None
+        self._served: list[IncrementResult] = []
+        self._loaded_result: IncrementResult | None = None
+        self._fresh_for_cycle = False
+        self._time_of: dict[int, float] = {}
+        self._nodal_cache: dict[tuple[str, float], NDArray[np.float64]] = {}
+        self.mesh: Mesh3D = self._mesh0  #: the (morphed) mesh of the last job
+
+    # -- geometry -------------------------------------------------------------------------
+    @property
+    def hertz(self) -> tuple[float, float]:
+        """Hertz (p0 Pa, a m) of the unworn contact (a sphere of radius R on a flat)."""
+        hz = HertzSphere(self.radius, self.load, self.modulus)
+        return hz.peak_pressure, hz.contact_radius
+
+    @property
+    def pad(self) -> float:
+        """Half-length the lower body's track extends beyond the window along x, m (the
+        loop's track grid: ceil(A / dx) + 1 cells)."""
+        return (math.ceil(self.amplitude / self.dx) + 1) * self.dx
+
+    def _base_mesh(self) -> Mesh3D:
+        """The unworn half mesh with the element sets ``UCOL``/``LCOL`` of the columns under
+        the window (lower: plus the stroke) down to :attr:`stress_depth`."""
+        a = self.hertz[1]
+        case = CrossedCase(load=self.load, radius=self.radius, h_fine=self.h_over_a * a,
+                           size_factor=self.size_factor, growth=self.growth,
+                           delta=self.amplitude)
+        mesh = crossed_mesh(case, a=a, shift_lower=0.5 * case.h_fine)
+        cols = mesh_columns(mesh)
+        depth = np.full(mesh.nodes.shape[0], np.inf)
+        for body in BODIES:
+            cb = cols[body]
+            depth[cb] = np.abs(mesh.nodes[cb, 2] - mesh.nodes[cb[..., :1], 2])
+        c = self.coords
+        xe = mesh.nodes[mesh.elements, 0]
+        ye = mesh.nodes[mesh.elements, 1]
+        near = (depth[mesh.elements].min(axis=1) < self.stress_depth) & (
+            ye.min(axis=1) <= c[-1])
+        el = np.arange(1, mesh.elements.shape[0] + 1)
+        lower = el <= mesh.n_lower
+        for name, body, lo, hi in (("LCOL", lower, c[0] - self.pad, c[-1] + self.pad),
+                                   ("UCOL", ~lower, c[0], c[-1])):
+            keep = body & near & (xe.min(axis=1) <= hi) & (xe.max(axis=1) >= lo)
+            mesh.element_sets[name] = el[keep]
+        return mesh
+
+    def column_wear(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Worn depth (m, >= 0) at each node column (j, i) of the (upper, lower) mesh, [ny,
+        nx]: the current recession minus the unworn one at the column's (x, y) (upper: its
+        own frame, lower: lab frame); zero outside the window (upper) and the window plus the
+        stroke (lower) along x, and beyond the window's last point along y, where the loop
+        gives no surface."""
+        c = self.coords
+        out = []
+        for body, now, base, lo, hi in (
+                ("upper", self.upper, self._base_upper, c[0], c[-1]),
+                ("lower", self.lower, self._base_lower, c[0] - self.pad, c[-1] + self.pad)):
+            x, y = np.meshgrid(*self._grids[body])
+            inside = (x >= lo) & (x <= hi) & (y <= c[-1])
+            w = np.zeros_like(x)
+            xi, yi = x[inside], y[inside]
+            w[inside] = (np.asarray(now(xi, yi), dtype=float)
+                         - np.asarray(base(xi, yi), dtype=float))
+            out.append(np.maximum(w, 0.0))
+        return out[0], out[1]
+
+    def morphed_mesh(self) -> Mesh3D:
+        """The unworn mesh with both surfaces receded by :meth:`column_wear` (eqs 3.7-3.8)."""
+        wu, wl = self.column_wear()
+        try:
+            m = morph_columns3d(self._mesh0, "upper", wu) if wu.any() else self._mesh0
+            return morph_columns3d(m, "lower", wl) if wl.any() else m
+        except ValueError as err:
+            raise FESolverStopped(f"mesh morphing: {err}") from None
+
+    def worn_volume(self, body: str, mesh: Mesh3D | None = None) -> float:
+        """Worn volume of ``body`` (m^3, both halves): the exact volume between the unworn and
+        the morphed surface of ``mesh`` (default: the last job's). The columns are vertical
+        over rectangles and the surfaces bilinear per cell, so it is the sum of the columns'
+        surface displacement times their tributary areas (= the hexahedra's volume loss)."""
+        mesh = self.mesh if mesh is None else mesh
+        top = self._cols[body][..., 0]
+        dz = np.abs(mesh.nodes[top, 2] - self._mesh0.nodes[top, 2])
+        return 2.0 * float((dz * self._areas[body]).sum())
+
+    def _seat(self, mesh: Mesh3D) -> float:
+        """Seating displacement, m: the smallest rigid gap between the (worn) surfaces (under
+        each upper surface node, the lower surface bilinear between its nodes) plus 5 % of
+        the Hertz approach a^2 / R."""
+        a = self.hertz[1]
+        up = mesh.nodes[self._cols["upper"][..., 0]]
+        z_lo = mesh.nodes[self._cols["lower"][..., 0], 2]
+        inside = (up[..., 0] >= self._xl[0]) & (up[..., 0] <= self._xl[-1])
+        below = _bilinear(self._xl, self._ys, z_lo, up[..., 0][inside], up[..., 1][inside])
+        gap = up[..., 2][inside] - below
+        return float(gap.min()) + 0.05 * a * a / self.radius
+
+    def _materials(self) -> tuple[FEMaterial, FEMaterial]:
+        lo, up = self.lower_material, self.upper_material
+        return FEMaterial(lo.young, lo.poisson), FEMaterial(up.young, up.poisson)
+
+    # -- the deck ---------------------------------------------------------------------------
+    def write_deck(self, path: str | Path, mesh: Mesh3D, seat: float, refine: int = 1) -> Path:
+        """The ccx deck: half model, node-to-surface pair once, seating (REF down by ``seat``
+        m, friction 0.001), the load P / 2 on REF (automatic increments <= 1/4), the cycle as
+        one step per quarter (REF x ramped to +A, 0, -A, 0, increments <= 4 / n_increments,
+        divided by ``refine``), outputs at the loop's offsets: the support's total reaction,
+        REF, both contact faces' displacements, the Gauss-point stresses of the upper contact
+        layer (``UCONT``, the tractions) and of the column sets ``UCOL``/``LCOL``."""
+        s = self.settings
+        lo_m, up_m = self._materials()
+        out = io.StringIO()
+        out.write("*HEADING\ntribodem fe3d: crossed cylinders, half model (y >= 0)\n")
+        out.write("*NODE, NSET=NALL\n")
+        for k, (x, y, z) in enumerate(mesh.nodes, start=1):
+            out.write(f"{k}, {_fmt(x)}, {_fmt(y)}, {_fmt(z)}\n")
+        for name, rows, first in (("LOWER", mesh.elements[:mesh.n_lower], 1),
+                                  ("UPPER", mesh.elements[mesh.n_lower:], mesh.n_lower + 1)):
+            out.write(f"*ELEMENT, TYPE=C3D8, ELSET={name}\n")
+            for k, c in enumerate(rows + 1, start=first):
+                out.write(f"{k}, " + ", ".join(str(int(v)) for v in c) + "\n")
+        for name, ids in mesh.node_sets.items():
+            out.write(f"*NSET, NSET={name}\n")
+            _write_ids(out, ids)
+        for name in ("UCONT", "LCONT", "UCOL", "LCOL"):
+            out.write(f"*ELSET, ELSET={name}\n")
+            _write_ids(out, mesh.element_sets[name])
+        out.write("*SURFACE, NAME=SUP, TYPE=ELEMENT\nUCONT, S1\n")
+        out.write("*SURFACE, NAME=SLOW, TYPE=ELEMENT\nLCONT, S2\n")
+        for name, m in (("MLOWER", lo_m), ("MUPPER", up_m)):
+            out.write(f"*MATERIAL, NAME={name}\n*ELASTIC\n{_fmt(m.young)}, {m.poisson}\n")
+        out.write("*SOLID SECTION, ELSET=LOWER, MATERIAL=MLOWER\n"
+                  "*SOLID SECTION, ELSET=UPPER, MATERIAL=MUPPER\n")
+        ref = int(mesh.node_sets["REF"][0])
+        out.write("*EQUATION\n")
+        for nid in mesh.node_sets["UTOP"]:
+            if int(nid) != ref:
+                for d in (1, 3):
+                    out.write(f"2\n{int(nid)}, {d}, 1., {ref}, {d}, -1.\n")
+        k_n = s.penalty_factor * min(lo_m.young, up_m.young) / mesh.h_fine
+        tension = "" if s.tension is None else f", {_fmt(s.tension)}"
+        out.write("*SURFACE INTERACTION, NAME=SI\n")
+        out.write(f"*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR\n{_fmt(k_n)}{tension}\n")
+        mu = max(s.mu, s.mu_loading)
+        out.write(f"*FRICTION\n{mu}, {_fmt(s.stick_factor * k_n)}\n")
+        sliding = ", SMALL SLIDING" if self.small_sliding else ""
+        out.write(f"*CONTACT PAIR, INTERACTION=SI, TYPE={s.formulation}{sliding}\nSUP, SLOW\n")
+        n_load = 4
+        q = self.n_increments // 4
+        _time_points(out, "TLOAD", np.arange(1, n_load + 1) / n_load)
+        _time_points(out, "TQUARTER", np.arange(1, q + 1) / q)
+        fixed = "SYMY, 2, 2\nLBOT, 1, 3\n"
+        out.write("*BOUNDARY\n" + fixed)
+
+        def friction(value: float, factor: float) -> str:
+            return f"*CHANGE FRICTION, INTERACTION=SI\n*FRICTION\n{value}, {_fmt(factor * k_n)}\n"
+
+        def outputs(tp: str) -> str:
+            return (f"*NODE PRINT, NSET=LBOT, TOTALS=ONLY, TIME POINTS={tp}\nRF\n"
+                    f"*NODE PRINT, NSET=REF, TIME POINTS={tp}\nU\n"
+                    f"*NODE PRINT, NSET=UBOT, TIME POINTS={tp}\nU\n"
+                    f"*NODE PRINT, NSET=LTOP, TIME POINTS={tp}\nU\n"
+                    f"*EL PRINT, ELSET=UCONT, TIME POINTS={tp}\nS\n"
+                    f"*EL PRINT, ELSET=UCOL, TIME POINTS={tp}\nS\n"
+                    f"*EL PRINT, ELSET=LCOL, TIME POINTS={tp}\nS\n")
+
+        refine = max(int(refine), 1)
+        out.write("*STEP, INC=200\n*STATIC\n0.5, 1., 1e-4, 0.5\n")
+        out.write(friction(s.mu_loading, s.stick_factor_loading))
+        out.write(f"*BOUNDARY\n{ref}, 1, 1, 0.\n{ref}, 3, 3, {_fmt(-seat)}\n*END STEP\n")
+        dt = 1.0 / (n_load * refine)
+        out.write(f"*STEP, INC=1000\n*STATIC\n{dt}, 1., {dt * 1e-4}, {dt}\n")
+        out.write("*BOUNDARY, OP=NEW\n" + fixed + f"{ref}, 1, 1, 0.\n")
+        out.write(f"*CLOAD\n{ref}, 3, {_fmt(-self.load / 2.0)}\n")
+        out.write(outputs("TLOAD") + "*END STEP\n")
+        dt = 4.0 / (self.n_increments * refine)
+        for k, target in enumerate((self.amplitude, 0.0, -self.amplitude, 0.0)):
+            out.write(f"*STEP, INC=10000\n*STATIC\n{dt}, 1., {dt * 1e-4}, {dt}\n")
+            if k == 0:
+                out.write(friction(s.mu, s.stick_factor))
+            out.write(f"*BOUNDARY\n{ref}, 1, 1, {_fmt(target)}\n")
+            out.write(outputs("TQUARTER") + "*END STEP\n")
+        path = Path(path)
+        path.write_text(out.getvalue())
+        return path
+
+    # -- the contract ---------------------------------------------------------------------
+    def reset(self) -> None:
+        """Forget the load history: the next ``solve_increment(0.0)`` is a first loading."""
+        self._k: int | None = None
+        self._loaded = False
+
+    def begin_cycle(self) -> None:
+        """Run this cycle's ccx job on the current surfaces (unless the last job was on the
+        same geometry and has served only the first loading)."""
+        self._start_cycle()
+
+    def _start_cycle(self) -> None:
+        if not (self._key() == self._job_key and self._served and self._fresh_for_cycle):
+            self._run_job()
+        self._fresh_for_cycle = False
+        self._cycle += 1
+        self._k = 0
+
+    def _key(self) -> tuple[bytes, bytes]:
+        wu, wl = self.column_wear()
+        return wu.tobytes(), wl.tobytes()
+
+    def solve_increment(self, offset: float) -> IncrementResult:
+        """Serve the stored increment ending at ``offset`` (m): ``0.0`` after :meth:`reset`
+        is the normal loading; then the cycle's offsets in order (:func:`cycle_offsets` of
+        ``amplitude``, ``n_increments``); anything else is a ``ValueError``."""
+        offset = float(offset)
+        if self._k is None:
+            if offset == 0.0 and not self._loaded:
+                if self._key() != self._job_key or not self._served:
+                    self._run_job()
+                self._fresh_for_cycle = True
+                self._loaded = True
+                assert self._loaded_result is not None
+                return self._loaded_result
+            self._start_cycle()
+        assert self._k is not None
+        expected = float(self.offsets[self._k])
+        if abs(offset - expected) > 1e-9 * self.amplitude:
+            raise ValueError(
+                f"offset = {offset!r} m is not increment {self._k + 1} of the fe3d job's cycle "
+                f"(expected {expected!r} m: amplitude {self.amplitude:g} m, n_increments "
+                f"{self.n_increments}); the fe3d backend serves the cycle 0 -> +A -> 0 -> -A "
+                "-> 0 in order")
+        inc = self._served[self._k]
+        self._k += 1
+        self._loaded = True
+        if self._k == len(self.offsets):
+            self._k = None
+        return inc
+
+    # -- the job --------------------------------------------------------------------------
+    def _folder(self) -> Path:
+        if self.workdir is None:
+            self.workdir = Path(tempfile.mkdtemp(prefix="tribodem-fe3d-"))
+        return self.workdir / f"cycle_{self._cycle + 1:04d}"
+
+    def _run_job(self) -> None:
+        """Mesh, morph, write, run (retrying with smaller increments) and read one job."""
+        t0 = time.perf_counter()
+        folder = self._folder()
+        folder.mkdir(parents=True, exist_ok=True)
+        mesh = self.morphed_mesh()
+        seat = self._seat(mesh)
+        t_mesh = time.perf_counter() - t0
+        t_ccx = 0.0
+        run: CcxRun | None = None
+        refine = 1
+        for attempt in range(self.retries + 1):
+            refine = 2**attempt
+            t1 = time.perf_counter()
+            deck = self.write_deck(folder / ("job.inp" if refine == 1 else
+                                             f"job_refine{refine}.inp"), mesh, seat, refine)
+            t_mesh += time.perf_counter() - t1
+            t2 = time.perf_counter()
+            try:
+                run = run_ccx(deck, threads=self.threads, timeout=self.timeout,
+                              executable=self.executable)
+            except CcxConvergenceError:
+                t_ccx += time.perf_counter() - t2
+                if attempt == self.retries:
+                    raise
+                continue
+            t_ccx += time.perf_counter() - t2
+            break
+        assert run is not None
+        t3 = time.perf_counter()
+        blocks = read_dat(run.dat)
+        states = self._read(blocks, mesh)
+        t_read = time.perf_counter() - t3
+        rec = JobRecord3D(cycle=self._cycle + 1, folder=folder, deck=run.job.with_suffix(".inp"),
+                          elements=int(mesh.elements.shape[0]), refine=refine,
+                          seconds_mesh=t_mesh, seconds_ccx=t_ccx, seconds_read=t_read,
+                          worn_volume_upper=self.worn_volume("upper", mesh),
+                          worn_volume_lower=self.worn_volume("lower", mesh))
+        t4 = time.perf_counter()
+        self.mesh = mesh
+        self._blocks = blocks
+        self._states = states
+        self._serve(states)
+        rec.seconds_map = time.perf_counter() - t4
+        self._job_key = self._key()
+        self.jobs.append(rec)
+        self._write_profile(rec)
+
+    def _write_profile(self, rec: JobRecord3D) -> None:
+        assert self.workdir is not None
+        path = self.workdir / "jobs.csv"
+        row = {"cycle": rec.cycle, "elements": rec.elements, "refine": rec.refine,
+               "seconds_mesh": f"{rec.seconds_mesh:.4f}", "seconds_ccx": f"{rec.seconds_ccx:.3f}",
+               "seconds_read": f"{rec.seconds_read:.4f}", "seconds_map": f"{rec.seconds_map:.4f}",
+               "worn_volume_upper_m3": f"{rec.worn_volume_upper:.9e}",
+               "worn_volume_lower_m3": f"{rec.worn_volume_lower:.9e}",
+               "deck": str(rec.deck)}
+        new = not path.exists()
+        with open(path, "a", newline="") as fh:
+            w = csv.DictWriter(fh, fieldnames=list(row))
+            if new:
+                w.writeheader()
+            w.writerow(row)
+
+    def _read(self, blocks: list[DatBlock], mesh: Mesh3D) -> list[dict[str, Any]]:
+        """Per output time of the loaded state and the cycle: total time, forces on the
+        upper body (N, both halves), nodal tractions on the upper surface (Pa, [ny, nx]:
+        p, qx, qy), the displacements of both contact faces ([ny, nx, 3], m) and of REF."""
+        want = np.concatenate([[2.0], 2.0 + 4.0 * np.arange(1, self.n_increments + 1)
+                               / self.n_increments])
+        by = {(b.kind, b.set_name, round(b.time, 9)): b for b in blocks}
+        times = np.array(sorted({round(b.time, 9) for b in blocks if b.kind == "total force"}))
+        ubot = self._cols["upper"][..., 0]
+        ltop = self._cols["lower"][..., 0]
+        n_nodes = mesh.nodes.shape[0]
+        states = []
+        for t in want:
+            k = int(np.argmin(np.abs(times - t))) if times.size else -1
+            if k < 0 or abs(times[k] - t) > 1e-6:
+                raise FESolverStopped(f"ccx output has no result at total time {t:g} (deck "
+                                      f"{self.workdir})")
+            tk = float(times[k])
+            rows = by[("stresses", "UCONT", tk)].rows
+            elems = rows[:, 0].astype(np.int64).reshape(-1, 8)[:, 0]
+            conn = mesh.elements[elems - 1]
+            f = element_forces(mesh.nodes[conn], rows[:, 2:8].reshape(-1, 8, 6))
+            total = np.zeros((n_nodes, 3))
+            np.add.at(total, conn[:, :4], f[:, :4])
+            u = np.zeros((n_nodes + 1, 3))
+            for name in ("UBOT", "LTOP", "REF"):
+                r = by[("displacements", name, tk)].rows
+                u[r[:, 0].astype(np.int64)] = r[:, 1:4]
+            fn = np.where(self._complete[..., None], total[ubot], 0.0) / self._area[..., None]
+            rf = by[("total force", "LBOT", tk)].rows[0, :3]
+            states.append({"time": tk, "p": fn[..., 2], "qx": fn[..., 0], "qy": fn[..., 1],
+                           "u_up": u[ubot + 1], "u_lo": u[ltop + 1],
+                           "u_ref": u[int(mesh.node_sets["REF"][0])],
+                           "force": np.array([2.0, 0.0, 2.0]) * rf})
+        return states
+
+    def _window(self, half: NDArray[np.float64], sign: float, average: bool
+                ) -> NDArray[np.float64]:
+        """A nodal field of the half surface grid [ny, nx] on the window [n (x), n (y)]."""
+        full = _mirror(half, sign)  # [2 ny - 1, nx]
+        if average:
+            return self._avg_x @ full.T @ self._avg_y.T
+        return self._pt_x @ full.T @ self._pt_y.T
+
+    def _serve(self, states: list[dict[str, Any]]) -> None:
+        """Map the job's surface fields to the window: the loaded state and the increments."""
+        n, cell = self.n, self.dx * self.dx
+        xs, xl, ys_full = self._xs, self._xl, self._ys_full
+        k_t = self.settings.stick_factor * self.settings.penalty_factor * min(
+            self.upper_material.young, self.lower_material.young) / self.mesh.h_fine
+        out: list[IncrementResult] = []
+        xg, yg = np.meshgrid(xs, self._ys)  # [ny, nx] undeformed upper surface nodes
+        prev: dict[str, Any] | None = None
+        for j, st in enumerate(states):
+            p_node = np.where(st["p"] > 1e-5 * st["p"].max(), st["p"], 0.0)
+            on = p_node > 0.0
+            p = self._window(p_node, 1.0, True)
+            p = np.where(p > 0.0, p, 0.0)
+            contact = p > 0.0
+            if contact[0].any() or contact[-1].any() or contact[:, 0].any() or \
+                    contact[:, -1].any():
+                raise WindowTooSmallError(
+                    f"the FE contact reaches the window edge (window {self.window:.4g} m, n "
+                    f"{n}): enlarge contact.window")
+            traction = np.zeros((n, n, 2))
+            slip = np.zeros((n, n, 2))
+            stick = None
+            if j == 0:
+                start, off, direction = 0.0, 0.0, 0.0
+            else:
+                assert prev is not None
+                traction[..., 0] = self._window(np.where(on, st["qx"], 0.0), 1.0, True)
+                traction[..., 1] = self._window(np.where(on, st["qy"], 0.0), -1.0, True)
+                lo0 = _mirror(prev["u_lo"][..., :2], 1.0)
+                lo0[: self._ys.size - 1, :, 1] *= -1.0  # u_y is odd in y
+                lo1 = _mirror(st["u_lo"][..., :2], 1.0)
+                lo1[: self._ys.size - 1, :, 1] *= -1.0
+                up0, up1 = prev["u_up"][..., :2], st["u_up"][..., :2]
+                # the lower body's material point under each upper node at the start
+                px, py = xg + up0[..., 0], yg + up0[..., 1]
+                u_at = _bilinear(xl, ys_full, lo0, px.ravel(), py.ravel()).reshape(up0.shape)
+                fx, fy = (px - u_at[..., 0]).ravel(), (py - u_at[..., 1]).ravel()
+                du_lo = (_bilinear(xl, ys_full, lo1, fx, fy)
+                         - _bilinear(xl, ys_full, lo0, fx, fy)).reshape(up0.shape)
+                s_node = np.where(on[..., None], (up1 - up0) - du_lo, 0.0)
+                slip[..., 0] = np.where(contact, self._window(s_node[..., 0], 1.0, False), 0.0)
+                slip[..., 1] = np.where(contact, self._window(s_node[..., 1], -1.0, False),
+                                        0.0)
+                stick_node = on & (np.hypot(s_node[..., 0], s_node[..., 1])
+                                   <= self.friction * p_node / k_t)
+                stick = (self._window(stick_node.astype(float), 1.0, False) > 0.5) & contact
+                off = float(self.offsets[j - 1])
+                start = float(self.offsets[j - 2]) if j >= 2 else 0.0
+                direction = math.copysign(1.0, off - start)
+            prev = st
+            out.append(IncrementResult(
+                offset=off, start_offset=start, direction=direction, pressure=p,
+                traction=traction, slip=slip, contact_area=float(contact.sum()) * cell,
+                normal_load=float(p.sum()) * cell, stick=stick))
+        self._loaded_result = out[0]
+        self._served = out[1:]
+        self._time_of = {id(inc): float(st["time"]) for inc, st in zip(out, states, strict=True)}
+        self._state_of = {float(st["time"]): st for st in states}
+        self._nodal_cache = {}
+
+    # -- subsurface stress ----------------------------------------------------------------
+    def _nodal_stress(self, body: str, t: float) -> NDArray[np.float64]:
+        """Stress at the nodes (Pa, [n_nodes, 6] ccx order xx, yy, zz, xy, xz, yz; NaN off
+        the column set) at total time ``t``: each element's Gauss-point stresses
+        extrapolated to its nodes (inverse trilinear map), averaged over the elements of a
+        node; on the surface nodes sigma_zz, sigma_xz, sigma_yz are the recovered contact
+        traction (the extrapolation overshoots in the steep Hertz gradient)."""
+        key = (body, t)
+        if key not in self._nodal_cache:
+            name = "LCOL" if body == "lower" else "UCOL"
+            block = next(b for b in self._blocks if b.kind == "stresses"
+                         and b.set_name == name and abs(b.time - t) < 1e-9)
+            rows = block.rows
+            elems = rows[:, 0].astype(np.int64).reshape(-1, 8)[:, 0]
+            conn = self.mesh.elements[elems - 1]
+            nodal = np.einsum("kg,mgc->mkc", _EXTRAPOLATE3, rows[:, 2:8].reshape(-1, 8, 6))
+            n_nodes = self.mesh.nodes.shape[0]
+            total = np.zeros((n_nodes, 6))
+            count = np.zeros(n_nodes)
+            np.add.at(total, conn, nodal)
+            np.add.at(count, conn, 1.0)
+            with np.errstate(invalid="ignore", divide="ignore"):
+                avg = total / count[:, None]
+            st = self._state_of[t]
+            top = self._cols[body][..., 0]
+            p = np.where(st["p"] > 1e-5 * st["p"].max(), st["p"], 0.0)
+            q = np.stack([np.where(p > 0, st["qx"], 0.0), np.where(p > 0, st["qy"], 0.0),
+                          p], axis=-1)
+            if body == "lower":  # the traction under each lower node: the upper node at
+                # undeformed x - u_ref (the lower surface node's position in the upper frame)
+                q_full = _mirror(q, 1.0)
+                q_full[: self._ys.size - 1, :, 1] *= -1.0
+                xg, yg = np.meshgrid(self._xl, self._ys)
+                q = _bilinear(self._xs, self._ys_full, q_full, (xg - st["u_ref"][0]).ravel(),
+                              yg.ravel()).reshape(q.shape)
+                q[(xg - st["u_ref"][0] < self._xs[0]) | (xg - st["u_ref"][0] > self._xs[-1])] = 0
+            # traction on the upper body (qx, qy, p) = -sigma . e_z at the interface, the same
+            # lab-frame sigma on both sides: sigma_xz = -qx, sigma_yz = -qy, sigma_zz = -p
+            known = np.isfinite(avg[top, 0])
+            avg[top[known], 4] = -q[known, 0]
+            avg[top[known], 5] = -q[known, 1]
+            avg[top[known], 2] = -q[known, 2]
+            self._nodal_cache = {key: avg}
+        return self._nodal_cache[key]
+
+    def subsurface_stress(self, result: IncrementResult, body: Body = "lower",
+                          depth: float | None = None, nz: int = 33) -> SubsurfaceStress:
+        """Stress under ``body`` for an increment this solver served (the current cycle's
+        job), on ``nz`` depths 0..``depth`` (m; default 3 sqrt(area / pi)) and the window's
+        (x, y) (lower body: lab x = window x + ``result.offset``). Nodal stresses
+        (:meth:`_nodal_stress`) are interpolated along each straight node column (i, j) by
+        the depth below its (worn) surface node, then bilinearly between columns; y < 0 from
+        the mirror (sigma_xy, sigma_yz odd). Frame: x, y, z = depth into the body: sigma_xz
+        = qx under the lower body and -qx in the upper one at the surface (the half-space
+        backend's convention)."""
+        if body not in BODIES:
+            raise ValueError(f"body = {body!r} is not allowed: use 'upper' or 'lower'")
+        t = self._time_of.get(id(result))
+        if t is None:
+            raise ValueError("result is not an increment of the fe3d solver's current job "
+                             "(subsurface stress is kept for the current cycle only)")
+        if int(nz) != nz or nz < 2:
+            raise ValueError(f"nz = {nz!r} is not allowed: must be an integer >= 2")
+        if depth is None:
+            depth = 3.0 * math.sqrt(max(result.contact_area, self.dx**2) / math.pi)
+        depth = _check_positive("depth", depth)
+        if depth > self.stress_depth * (1 + 1e-9):
+            raise ValueError(f"depth = {depth!r} m is not allowed: the fe3d solver prints the "
+                             f"column stresses down to {self.stress_depth:.4g} m (its "
+                             "stress_depth; wear.stress_depth of a fretting config)")
+        nodal = self._nodal_stress(body, t)
+        cols = self._cols[body]  # [ny, nx, nl]
+        zc = self.mesh.nodes[cols, 2]
+        d = np.abs(zc - zc[..., :1])  # depth below the surface node, increasing
+        z = np.linspace(0.0, depth, int(nz))
+        v = nodal[cols]  # [ny, nx, nl, 6]
+        ok = np.isfinite(v[..., 0])
+        # first nl with the depth: k such that d[k] <= z < d[k + 1]
+        k = np.clip((d[..., None, :] <= z[:, None]).sum(axis=-1) - 1, 0, d.shape[-1] - 2)
+        d0 = np.take_along_axis(d, k, axis=-1)
+        d1 = np.take_along_axis(d, k + 1, axis=-1)
+        w = np.clip((z - d0) / (d1 - d0), 0.0, 1.0)[..., None]
+        v0 = np.take_along_axis(v, k[..., None], axis=2)
+        v1 = np.take_along_axis(v, (k + 1)[..., None], axis=2)
+        prof = (1 - w) * v0 + w * v1  # [ny, nx, nz, 6]
+        good = np.take_along_axis(ok, k, axis=-1) & np.take_along_axis(ok, k + 1, axis=-1)
+        x = self.coords + (result.offset if body == "lower" else 0.0)
+        y = self.coords
+        full = np.concatenate([prof[:0:-1] * np.array([1, 1, 1, -1, 1, -1]), prof], axis=0)
+        gfull = np.concatenate([good[:0:-1], good], axis=0)
+        X, Y = np.meshgrid(x, y, indexing="ij")
+        xb = self._grids[body][0]
+        s = _bilinear(xb, self._ys_full, full.reshape(full.shape[0], full.shape[1], -1),
+                      X.ravel(), Y.ravel()).reshape(self.n, self.n, z.size, 6)
+        gi = _bilinear(xb, self._ys_full,
+                       gfull.astype(float).reshape(gfull.shape[0], gfull.shape[1], -1),
+                       X.ravel(), Y.ravel())
+        if np.any(gi < 1.0 - 1e-12):
+            raise ValueError(f"no column stresses under the window down to depth {depth:.4g} m "
+                             f"on the {body} body")
+        s = np.moveaxis(s, 2, 0)  # [nz, n, n, 6] ccx order
+        sign = -1.0 if body == "lower" else 1.0  # z = depth: flipped under the lower body
+        voigt = np.empty_like(s)
+        voigt[..., 0], voigt[..., 1], voigt[..., 2] = s[..., 0], s[..., 1], s[..., 2]
+        voigt[..., 3] = sign * s[..., 5]
+        voigt[..., 4] = sign * s[..., 4]
+        voigt[..., 5] = s[..., 3]
+        return SubsurfaceStress(body=body, z=z, x=self.coords, y=self.coords, stress=voigt,
+                                von_mises=von_mises(voigt), tresca=max_shear(voigt))
+
+    # -- resume ---------------------------------------------------------------------------
+    def state_dict(self) -> dict[str, Any]:
+        """A fresh-mode solver holds no load history between cycles: the cycle counter,
+        whether the bodies were loaded, the mode and the work folder."""
+        return {"cycle": self._cycle, "loaded": self._loaded, "mode": self.mode,
+                "workdir": None if self.workdir is None else str(self.workdir)}
+
+    def load_state_dict(self, state: dict[str, Any]) -> None:
+        """Restore :meth:`state_dict` (the next cycle runs its own job)."""
+        if state.get("mode", "fresh") != self.mode:
+            raise ValueError(f"saved fe3d mode {state.get('mode')!r}, this solver "
+                             f"{self.mode!r}")
+        self._cycle = int(state["cycle"])
+        self._loaded = bool(state["loaded"])
+        self._k = None
+        self._job_key = None
+        self._served = []
+        if self.workdir is None and state.get("workdir"):
+            self.workdir = Path(state["workdir"])
+
+    def profile(self) -> dict[str, float]:
+        """Seconds per job averaged over the jobs run (meshing with morphing and the deck,
+        ccx, reading, mapping to the window) and the number of jobs."""
+        if not self.jobs:
+            return {"jobs": 0}
+        keys = ("seconds_mesh", "seconds_ccx", "seconds_read", "seconds_map")
+        return {"jobs": len(self.jobs),
+                **{k: float(np.mean([getattr(j, k) for j in self.jobs])) for k in keys}}
+
+    def write_json(self, path: str | Path) -> Path:
+        """The jobs' records as JSON (for a run folder)."""
+        path = Path(path)
+        path.write_text(json.dumps([{**vars(j), "folder": str(j.folder), "deck": str(j.deck)}
+                                    for j in self.jobs], indent=1))
+        return path
