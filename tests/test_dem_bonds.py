@@ -11,6 +11,7 @@ from tribodem.dem.bonds import (
     ParallelBonds,
     bond_csr,
     bond_forces,
+    bond_forces_2d,
     gather_bonds,
     install_bonds_by_gap,
 )
@@ -231,6 +232,58 @@ def test_threaded_and_serial_kernels_agree_bitwise() -> None:
     for a, b in zip(outs[0][1], outs[1][1], strict=True):
         assert np.array_equal(a, b)
     assert np.any(outs[0][1][-2] != 0.25)
+
+
+def test_2d_kernel_matches_the_general_one() -> None:
+    """Disks: ``bond_forces_2d`` gives the general kernel's values (== equality, so only
+    the sign of zeros may differ) on serial summed and threaded stored passes, over
+    several steps with breaks."""
+    rng = np.random.default_rng(5)
+    n, nb = 2000, 4500
+    pos = np.c_[rng.uniform(0, 0.1, (n, 2)), np.zeros(n)]
+    vel = np.c_[rng.normal(0, 1e-3, (n, 2)), np.zeros(n)]
+    omega = np.c_[np.zeros((n, 2)), rng.normal(0, 1e-1, n)]
+    radius = rng.uniform(0.8, 1.2, n) * R
+    i = rng.integers(0, n // 2, nb)
+    j = rng.integers(n // 2, n, nb)
+    d = pos[j] - pos[i]
+    nrm = d / np.linalg.norm(d, axis=1)[:, None]
+    nrm[:, :2] += rng.normal(0, 1e-3, (nb, 2))  # the normal turned since the last step
+    one = np.ones(nb)
+    length, periodic = np.array([0.1, 0.0, 0.0]), np.array([True, False, False])
+    gstart, gbond = bond_csr(i, j, n, by_bond=True)
+    fs = np.c_[rng.normal(0, 1e-3, (nb, 2)), np.zeros(nb)]
+    mb = np.c_[np.zeros((nb, 2)), rng.normal(0, 1e-9, nb)]
+    for summed in (True, False):
+        outs = []
+        for two in (False, True):
+            arrays = [np.zeros(nb), fs.copy(), mb.copy(), np.zeros(nb), nrm.copy(),
+                      np.zeros(nb, np.int8), np.zeros(nb, np.int8), np.zeros((nb, 9)),
+                      np.zeros((nb, 3)), np.zeros((nb, 3)), np.zeros((nb, 3))]
+            ext = [np.zeros((n, 3)), np.zeros((n, 3))]
+            props = (R * one, 1e-6 * one, 1e-13 * one, 5e11 * one, 3e11 * one,
+                     2e3 * one, 3e3 * one, 0.1 * one)
+            nnew = 0
+            for _ in range(3):
+                for e in ext:
+                    e[:] = 0.0
+                if two:
+                    build = bond_forces_2d.serial if summed else bond_forces_2d.parallel
+                    nnew += build(pos, vel, omega, radius, i, j, *props, arrays[0], arrays[1],
+                                  arrays[2], *arrays[4:], 1e-4, length, periodic, summed,
+                                  *ext)
+                else:
+                    build = bond_forces.serial if summed else bond_forces.parallel
+                    nnew += build(pos, vel, omega, radius, i, j, *props[:3], 2e-13 * one,
+                                  *props[3:], *arrays, 2, 1e-4, length, periodic, summed,
+                                  *ext)
+                if not summed:
+                    gather_bonds.parallel(gstart, gbond, i, arrays[5], *arrays[8:], *ext)
+            outs.append((nnew, arrays, ext))
+        (n1, a1, e1), (n2, a2, e2) = outs
+        assert 0 < n1 == n2 < nb
+        for x, y in zip(a1 + e1, a2 + e2, strict=True):
+            assert np.array_equal(x, y)
 
 
 def test_bad_input_is_refused() -> None:

@@ -241,6 +241,121 @@ def bond_forces(pos, vel, omega, radius, bi, bj, rb, area, ib, jb, kn, ks, tens,
     return nnew
 
 
+@kernel(chunk=256)
+def bond_forces_2d(pos, vel, omega, radius, bi, bj, rb, area, ib, kn, ks, tens, coh, tanphi,
+                   fn, fs, mb, nrm, mode, newly, brk, fbond, tbi, tbj, dt, length, periodic,
+                   summed, ext_force, ext_torque):
+    """``bond_forces`` for disks (dim 2), the same operations without the terms that are
+    exactly zero in the plane (z of positions, velocities, normals, shear forces, x and y
+    of spins and bending moments: ``ParticleState`` fixes them, ``FIX_2D``): the same
+    values as ``bond_forces`` (only the sign of zero components may differ), in about
+    half the instructions. Arguments as there (no twist: no ``jb``, ``mt``, ``dim``);
+    the x and y of ``mb`` and the z of ``fs`` are left as they are (zero)."""
+    nb = bi.shape[0]
+    nnew = 0
+    for b in prange(nb):
+        if mode[b] != INTACT:
+            continue
+        i = bi[b]
+        j = bj[b]
+        d0 = min_image(pos[j, 0] - pos[i, 0], length[0], periodic[0])
+        d1 = min_image(pos[j, 1] - pos[i, 1], length[1], periodic[1])
+        dist = np.sqrt(d0 * d0 + d1 * d1)
+        inv = 1.0 / dist
+        n0 = d0 * inv
+        n1 = d1 * inv
+        # rigid rotation old -> new normal about z (k = o x n = (0, 0, k2)); no spin term
+        o0, o1 = nrm[b, 0], nrm[b, 1]
+        c = o0 * n0 + o1 * n1
+        k2 = o0 * n1 - o1 * n0
+        s0, s1 = fs[b, 0], fs[b, 1]
+        mz = mb[b, 2]
+        if c > -1.0:  # _rotate: the shear force turns with the normal, kv = 0 for it
+            r0 = c * s0 - k2 * s1
+            r1 = c * s1 + k2 * s0
+            mz = c * mz + k2 * mz / (1.0 + c) * k2
+        else:
+            r0 = s0
+            r1 = s1
+        rn = r0 * n0 + r1 * n1  # round-off only: keep it tangential
+        s0 = r0 - rn * n0
+        s1 = r1 - rn * n1
+        nrm[b, 0] = n0
+        nrm[b, 1] = n1
+        # contact point arms: i -> x_c = a_i n, j -> x_c = -a_j n
+        ai = radius[i] + 0.5 * (dist - radius[i] - radius[j])
+        aj = dist - ai
+        wi2 = omega[i, 2]
+        wj2 = omega[j, 2]
+        v0 = (vel[j, 0] + aj * (wj2 * n1)) - (vel[i, 0] - ai * (wi2 * n1))
+        v1 = (vel[j, 1] - aj * (wj2 * n0)) - (vel[i, 1] + ai * (wi2 * n0))
+        vn = v0 * n0 + v1 * n1
+        kna = kn[b] * area[b]
+        ksa = ks[b] * area[b]
+        fnb = fn[b] - kna * vn * dt
+        s0 -= ksa * (v0 - vn * n0) * dt
+        s1 -= ksa * (v1 - vn * n1) * dt
+        mz -= kn[b] * ib[b] * ((wj2 - wi2) * dt)
+        # maximum stresses (seed 000 eq 11, Potyondy & Cundall 2004), tension positive
+        fsm = np.sqrt(s0 ** 2 + s1 ** 2)
+        mbm = np.sqrt(mz ** 2)
+        sig_n = -fnb / area[b]
+        sigma = sig_n + mbm * rb[b] / ib[b]
+        tau = fsm / area[b]
+        how = INTACT
+        if sigma >= tens[b]:
+            how = TENSILE
+        elif tau >= coh[b] - sig_n * tanphi[b]:
+            how = SHEAR
+        if how != INTACT:
+            mode[b] = how
+            newly[b] = 1
+            nnew += 1
+            brk[b, B_X] = pos[i, 0] + ai * n0
+            brk[b, B_Y] = pos[i, 1] + ai * n1
+            brk[b, B_Z] = pos[i, 2]
+            brk[b, B_FN] = fnb
+            brk[b, B_FS] = fsm
+            brk[b, B_MB] = mbm
+            brk[b, B_MT] = 0.0
+            brk[b, B_SIGMA] = sigma
+            brk[b, B_TAU] = tau
+            fn[b] = 0.0
+            for k in range(3):
+                fs[b, k] = 0.0
+                mb[b, k] = 0.0
+                if not summed:
+                    fbond[b, k] = 0.0
+                    tbi[b, k] = 0.0
+                    tbj[b, k] = 0.0
+            continue
+        fn[b] = fnb
+        fs[b, 0] = s0
+        fs[b, 1] = s1
+        mb[b, 2] = mz
+        f0 = fnb * n0 + s0
+        f1 = fnb * n1 + s1
+        cz = n0 * f1 - n1 * f0  # arm x force about z
+        if summed:
+            ext_force[i, 0] -= f0
+            ext_force[i, 1] -= f1
+            ext_torque[i, 2] += -ai * cz - mz
+            ext_force[j, 0] += f0
+            ext_force[j, 1] += f1
+            ext_torque[j, 2] += -aj * cz + mz
+            continue
+        fbond[b, 0] = f0
+        fbond[b, 1] = f1
+        fbond[b, 2] = 0.0
+        tbj[b, 0] = 0.0
+        tbj[b, 1] = 0.0
+        tbj[b, 2] = -aj * cz + mz
+        tbi[b, 0] = 0.0
+        tbi[b, 1] = 0.0
+        tbi[b, 2] = -ai * cz - mz
+    return nnew
+
+
 @kernel
 def gather_bonds(cstart, cbond, bi, mode, fbond, tbi, tbj, ext_force, ext_torque):
     """Add bond forces/moments to each particle (prange over particles, fixed order).
@@ -374,12 +489,20 @@ class ParallelBonds:
         p = sim.p
         threads = sim._threads
         summed = serial_run(self.n_bonds, threads)
-        nnew = bond_forces.pick(self.n_bonds, threads)(
-            p.pos, p.vel, p.omega, p.radius, self.i, self.j, self.rb, self.area, self.inertia,
-            self.polar, self.kn, self.ks, self.tensile, self.cohesion, self.tan_phi, self.fn,
-            self.fs, self.mb, self.mt, self.normal, self.mode, self.newly, self.brk,
-            self.fbond, self.tbi, self.tbj, self.dim, sim.dt, sim.box.length,
-            sim.box.periodic, summed, sim.ext_force, sim.ext_torque)
+        if self.dim == 2:
+            nnew = bond_forces_2d.pick(self.n_bonds, threads)(
+                p.pos, p.vel, p.omega, p.radius, self.i, self.j, self.rb, self.area,
+                self.inertia, self.kn, self.ks, self.tensile, self.cohesion, self.tan_phi,
+                self.fn, self.fs, self.mb, self.normal, self.mode, self.newly, self.brk,
+                self.fbond, self.tbi, self.tbj, sim.dt, sim.box.length, sim.box.periodic,
+                summed, sim.ext_force, sim.ext_torque)
+        else:
+            nnew = bond_forces.pick(self.n_bonds, threads)(
+                p.pos, p.vel, p.omega, p.radius, self.i, self.j, self.rb, self.area,
+                self.inertia, self.polar, self.kn, self.ks, self.tensile, self.cohesion,
+                self.tan_phi, self.fn, self.fs, self.mb, self.mt, self.normal, self.mode,
+                self.newly, self.brk, self.fbond, self.tbi, self.tbj, self.dim, sim.dt,
+                sim.box.length, sim.box.periodic, summed, sim.ext_force, sim.ext_torque)
         if nnew:
             self._log_breaks(sim)
         if not summed:  # threaded: each bond stored, gathered per particle in bond order
