@@ -38,6 +38,7 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
+from numba import njit
 from scipy.spatial import cKDTree
 
 from tribodem.dem import Box, Material, ParallelBonds, ParticleState, PlaneWall, Simulation
@@ -230,6 +231,19 @@ def _pairs_periodic(pos: np.ndarray, radius: np.ndarray, width: float, gap: floa
     return i[keep], j[keep], g[keep]
 
 
+@njit(cache=True)
+def _dashpots(vel, idx, v_plate, c_n, c_t, ext_force, dv):  # pragma: no cover - numba
+    """The backing dashpots of particles ``idx``: ``F_y -= c_n (v_y - v_plate)``,
+    ``F_x -= c_t v_x`` into ``ext_force`` (N); ``dv`` gets each ``v_y - v_plate`` (m/s).
+    One compiled call instead of numpy's fancy indexing (same operations, same bits)."""
+    for k in range(idx.shape[0]):
+        p = idx[k]
+        d = vel[p, 1] - v_plate
+        dv[k] = d
+        ext_force[p, 1] -= c_n * d
+        ext_force[p, 0] -= c_t * vel[p, 0]
+
+
 class PadBacking:
     """Non-reflecting (Lysmer-Kuhlemeyer) backing of the pad's top layer (an engine
     ``Interaction``): the rest of the pad as a semi-infinite elastic medium.
@@ -254,14 +268,15 @@ class PadBacking:
         self.target = float(wall.target_force)
         self.reaction = 0.0  # N, the dashpots' push on the plate (+: up, against the load)
         self.c_p, self.c_s = c_p, c_s
+        self._dv = np.zeros(idx.size)  # each dashpot's normal speed (m/s), reused
 
     def compute(self, sim: Simulation) -> None:
         """Add the dashpot forces; set the plate's drive to target minus their reaction."""
-        v = sim.p.vel[self.idx]
-        dv = v[:, 1] - float(self.wall.velocity[1])
-        sim.ext_force[self.idx, 1] -= self.c_n * dv
-        sim.ext_force[self.idx, 0] -= self.c_t * v[:, 0]
-        self.reaction = float(self.c_n * dv.sum())
+        if self._dv.size != self.idx.size:
+            self._dv = np.zeros(self.idx.size)
+        _dashpots(sim.p.vel, self.idx, float(self.wall.velocity[1]), self.c_n, self.c_t,
+                  sim.ext_force, self._dv)
+        self.reaction = float(self.c_n * self._dv.sum())  # numpy's sum, as before
         self.wall.target_force = self.target - self.reaction
 
     @property

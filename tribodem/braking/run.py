@@ -185,11 +185,7 @@ CONTACT_EVERY = 16
 def interface_load(iface: Interface) -> float:
     """Load (N) carried through the interface now: the summed normal force of the active
     contacts between a disc particle and a pad particle (matrix or debris)."""
-    c = iface.sim.contacts()
-    g = iface.sim.p.group
-    f = c["normal_force"]
-    cross = (g[c["i"]] != g[c["j"]]) & (f > 0)
-    return float(f[cross].sum())
+    return iface.sim.cross_group_force()  # the groups are the bodies (DISC, PAD)
 
 
 def _slope(x: np.ndarray, y: np.ndarray) -> float:

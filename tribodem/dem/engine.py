@@ -34,6 +34,19 @@ from tribodem.io.results import write_npz
 CHECKPOINT_VERSION = 1
 
 
+@numba.njit(cache=True)
+def _cross_forces(pinfo, pair_i, pair_j, group, out):  # pragma: no cover - numba
+    """Write into ``out`` (in pair order) the normal force of every touching pair
+    (overlap > 0) between different groups that pushes (N > 0); returns their number."""
+    k = 0
+    for p in range(pair_i.shape[0]):
+        f = pinfo[p, 1]
+        if pinfo[p, 0] > 0.0 and f > 0.0 and group[pair_i[p]] != group[pair_j[p]]:
+            out[k] = f
+            k += 1
+    return k
+
+
 class Interaction(Protocol):
     """An extra force contribution (bonds, thermal loads, ...).
 
@@ -98,6 +111,7 @@ class Simulation:
                                   box.periodic)
         self.hist = np.zeros((self.nl.n_pairs, HIST))
         self._threads: int | None = None  # numba threads, read once per step() call
+        self._cross = np.zeros(0)  # cross_group_force's buffer
         self._alloc_pairs()
         self.ext_force = np.zeros((n, 3))
         self.ext_torque = np.zeros((n, 3))
@@ -219,6 +233,19 @@ class Simulation:
         self._wforce[:] = 0.0
         self._wtorque[:] = 0.0
 
+    def _refresh_walls(self) -> None:
+        """The walls' point, normal, velocity and material of this step into the arrays of
+        ``_walls_now``, in place (a fresh ``wall_arrays`` if the wall count changed)."""
+        wp, wn, wv, wm = self._walls_now
+        if wp.shape[0] != len(self.walls):
+            self._walls_now = wall_arrays(self.walls)
+            return
+        for k, w in enumerate(self.walls):
+            wp[k] = w.point
+            wn[k] = w.normal
+            wv[k] = w.velocity
+            wm[k] = w.material
+
     def _maybe_rebuild(self) -> None:
         if self.walls:
             wp0, wn0 = self._wall_ref
@@ -300,7 +327,7 @@ class Simulation:
                 self._sample(force=True)
             for _ in range(n):
                 # the walls' arrays of this step (they move only after the update)
-                self._walls_now = wall_arrays(self.walls)
+                self._refresh_walls()
                 self._maybe_rebuild()
                 self._pair_forces()
                 if self.interactions:
@@ -422,6 +449,22 @@ class Simulation:
 
     def _active(self) -> np.ndarray:
         return self._overlaps() > 0
+
+    def cross_group_force(self) -> float:
+        """Summed normal force (N) of the touching pairs whose two particles are in
+        different groups and push (normal force > 0): the load through an interface
+        between bodies. Equals ``contacts()`` filtered on the groups and summed with numpy
+        (same bits), without building the contact arrays."""
+        if not self._evaluated:
+            c = self.contacts()
+            g = self.p.group
+            f = c["normal_force"]
+            return float(f[(g[c["i"]] != g[c["j"]]) & (f > 0)].sum())
+        if self._cross.shape[0] != self.nl.n_pairs:
+            self._cross = np.zeros(self.nl.n_pairs)
+        k = _cross_forces(self.pinfo, self.nl.pair_i, self.nl.pair_j, self.p.group,
+                          self._cross)
+        return float(self._cross[:k].sum())
 
     def n_contacts(self) -> int:
         """Particle-particle contacts carrying force (touching, before the first step)."""
