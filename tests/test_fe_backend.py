@@ -298,10 +298,10 @@ def test_fe_usage_errors_exit_2(tmp_path: Path) -> None:
     r = run_tribodem("fretting", "run", "--config", str(cfg), "--threads", "999", "--out",
                      str(tmp_path / "a"), "--no-progress")
     assert r.returncode == 2 and "--threads = 999" in r.stderr and "allowed" in r.stderr
-    cfg.write_text(CONFIG.replace("[fe]\n", "[fe]\nmode = \"chained\"\n"))
+    cfg.write_text(CONFIG.replace("[fe]\n", "[fe]\nmode = \"replayed\"\n"))
     r = run_tribodem("fretting", "run", "--config", str(cfg), "--out", str(tmp_path / "b"),
                      "--no-progress")
-    assert r.returncode == 2 and "fe.mode" in r.stderr and "fresh" in r.stderr
+    assert r.returncode == 2 and "fe.mode" in r.stderr and "chained" in r.stderr
     assert "Traceback" not in r.stderr
 
 

@@ -191,7 +191,9 @@ class FirstBodySolver(ABC):
       (``plastic``);
     - debris (``debris``): :meth:`set_debris_pressure`, :attr:`debris_pressure`,
       :attr:`debris_load`, :meth:`loaded_solution`;
-    - resume: :meth:`state_dict` / :meth:`load_state_dict`.
+    - resume: :meth:`state_dict` / :meth:`load_state_dict`;
+    - options and reports: :meth:`capabilities_for` (the capabilities of a configured
+      instance), :meth:`options_for`, :meth:`report` (for summary.json).
     """
 
     #: what this backend can give (class attribute of each backend)
@@ -218,6 +220,25 @@ class FirstBodySolver(ABC):
     def coords(self) -> NDArray[np.float64]:
         """Window point coordinates along x or y relative to the window centre, m."""
         return (np.arange(self.n) - self.n // 2) * self.dx
+
+    @classmethod
+    def capabilities_for(cls, options: dict[str, Any]) -> Capabilities:
+        """What an instance built with ``options`` (its config table, e.g. ``[fe]``) can
+        give; checked before any work. Default: :attr:`capabilities` (no option changes it)."""
+        del options
+        return cls.capabilities
+
+    @classmethod
+    def options_for(cls, names: set[str]) -> str:
+        """The options under which this backend gives the capabilities ``names`` it lacks
+        as configured (for messages; "" when no option gives them)."""
+        del names
+        return ""
+
+    def report(self) -> dict[str, Any]:
+        """What the backend measured over the run besides the surface fields (e.g. peak
+        stresses, plastic strain, timings), for summary.json; default: nothing."""
+        return {}
 
     def set_surfaces(self, upper: Recession, lower: Recession) -> None:
         """Give the (worn) surfaces the next increments see (recessions, m)."""

@@ -102,13 +102,20 @@ class PlasticSubsurfaceStress(SubsurfaceStress):
 
 @dataclass
 class PlasticStep:
-    """One EPIC load step on the coarse grid (both bodies, lab frame at offset 0)."""
+    """One plastic load step on a [nz, nx, ny] grid under a body.
 
-    z: NDArray[np.float64]  #: depths, m, [nz]
-    x: NDArray[np.float64]  #: x = y coordinates, m, [n]
-    dp: NDArray[np.float64]  #: increment of the cumulated plastic strain, -, [nz, n, n]
-    stress: NDArray[np.float64]  #: Cauchy stress at the end of the step, Pa, [nz, n, n, 6]
+    EPIC (``body`` None): one state shared by both bodies, on the coarse grid at offset 0
+    (x = y coordinates). A backend with a state per body (``fe``) sets ``body`` and ``y``:
+    the upper body's grid is in its own (window) frame, the lower body's in the lab frame.
+    """
+
+    z: NDArray[np.float64]  #: depths below the body's surface, m, [nz]
+    x: NDArray[np.float64]  #: x coordinates, m, [nx] (and y when ``y`` is None)
+    dp: NDArray[np.float64]  #: increment of the cumulated plastic strain, -, [nz, nx, ny]
+    stress: NDArray[np.float64]  #: Cauchy stress at the end of the step, Pa, [nz, nx, ny, 6]
     load: float  #: normal load at the end of the step, N
+    body: str | None = None  #: "upper", "lower", or None: both bodies (one shared state)
+    y: NDArray[np.float64] | None = None  #: y coordinates, m, [ny] (None: y = x)
 
 
 class ElastoPlasticSolver(HalfSpaceSolver):

@@ -501,8 +501,10 @@ class DFDICriterion(Criterion):
     cycles per material point on a [nz, ...] grid under each body (the damaged layer moves
     up as wear removes material); wear depth by :func:`column_search` at DFDI = 1.
     ``eps0`` default 0.132 (engineering strain at the UTS implied by seed table 6.2's
-    1000 -> 1132 MPa conversion; the seed gives no number). Needs a solver that exposes
-    a solver with the ``plastic`` capability (:class:`tribodem.contact.ElastoPlasticSolver`).
+    1000 -> 1132 MPa conversion; the seed gives no number). Needs a solver with the
+    ``plastic`` capability (:class:`tribodem.contact.ElastoPlasticSolver`: one plastic
+    state shared by both bodies; ``fe`` with ``material = "elastic-plastic"``: one per
+    body, :attr:`PlasticStep.body`).
     """
 
     name = "dfdi"
@@ -556,17 +558,29 @@ class DFDICriterion(Criterion):
         assert self._d_up is not None and self._d_lo is not None
         g = self.grid
         steps = self.solver.plastic_steps()
-        if steps:
-            dd = sum(self.damage_increment(st.dp, st.stress) for st in steps)
-            c = steps[0].x
-            interp = RegularGridInterpolator((steps[0].z, c, c), dd, bounds_error=False,
+
+        def on_grid(group: list[Any], x: NDArray[np.float64]) -> NDArray[np.float64]:
+            dd = sum(self.damage_increment(st.dp, st.stress) for st in group)
+            st = group[0]
+            y = st.x if st.y is None else st.y
+            interp = RegularGridInterpolator((st.z, st.x, y), dd, bounds_error=False,
                                              fill_value=0.0)
-            zz, xx, yy = np.meshgrid(self._z, g.x_upper, g.y, indexing="ij")
-            field = interp(np.stack([zz, xx, yy], -1))
+            zz, xx, yy = np.meshgrid(self._z, x, g.y, indexing="ij")
+            return interp(np.stack([zz, xx, yy], -1))
+
+        shared = [st for st in steps if st.body is None]
+        if shared:
             # both bodies carry the same plastic state (same traction, same material);
             # the EP solve is at offset 0: upper window frame, lower track at shift 0
+            field = on_grid(shared, g.x_upper)
             self._d_up += field
             self._d_lo[:, g.pad : g.pad + g.n, :] += field
+        # a state per body (fe): the upper's in its window frame, the lower's in the lab
+        for body, x, acc in (("upper", g.x_upper, self._d_up), ("lower", g.x_lower,
+                                                                 self._d_lo)):
+            own = [st for st in steps if st.body == body]
+            if own:
+                acc += on_grid(own, x)
         return _remove_damaged(self, {"max_dfdi_upper": float(self._d_up.max()),
                                       "max_dfdi_lower": float(self._d_lo.max())})
 

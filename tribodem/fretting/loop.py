@@ -293,6 +293,7 @@ class FrettingLoop:
             "max_traction_Pa": qmax,
             "contact_area_m2": area / len(self.offsets),
             **extra,
+            "criterion": crit.info(),  # this cycle's diagnostics (criterion.csv)
         }
 
     def _row(self, cycle: int, jumped: bool, per_cycle: dict[str, float]) -> dict[str, Any]:

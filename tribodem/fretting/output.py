@@ -21,8 +21,17 @@ CHECKPOINT_FORMAT = 1
 
 
 def write_rows(hist: FrettingHistory, out: Path) -> Path:
-    """``out/results.csv``: one row per cycle recorded so far (rewritten atomically)."""
+    """``out/results.csv``: one row per cycle recorded so far, and, when the criterion
+    reports per-cycle diagnostics (e.g. the largest DFDI or Miner sum), ``out/criterion.csv``
+    with one row per simulated cycle (both rewritten atomically)."""
     cols = RESULT_COLUMNS + (DEBRIS_COLUMNS if hist.debris is not None else ())
+    info = [(r["cycle"], r["criterion"]) for r in hist.rows
+            if not r.get("jumped") and r.get("criterion")]
+    if info:
+        keys = sorted({k for _, d in info for k, v in d.items()
+                       if isinstance(v, int | float)})
+        write_csv(out / "criterion.csv", ["cycle", *keys],
+                  ([c, *(d.get(k, "") for k in keys)] for c, d in info))
     return write_csv(out / "results.csv", cols,
                      ([r.get(c, "") for c in cols] for r in hist.rows))
 

@@ -41,11 +41,12 @@ slip ``|Q| = mu P`` (tests/test_fe_backend.py).
 from __future__ import annotations
 
 import csv
+import hashlib
 import json
 import math
 import tempfile
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -61,11 +62,13 @@ from tribodem.contact.base import (
     IncrementResult,
     Recession,
     SubsurfaceStress,
+    Unsupported,
     WindowTooSmallError,
     _check_positive,
     contact_modulus,
     cycle_offsets,
 )
+from tribodem.contact.elastoplastic import PlasticStep
 from tribodem.contact.fe.ccx import (
     CcxConvergenceError,
     CcxRun,
@@ -76,23 +79,42 @@ from tribodem.contact.fe.ccx import (
 from tribodem.contact.fe.deck import FEMaterial, LoadCase, sliding_contact, write_deck
 from tribodem.contact.fe.mesh import Mesh, PadOnFlat, cylinder_on_flat, hertz_line, morph_columns
 from tribodem.contact.fe.mesh import worn_area as mesh_worn_area
-from tribodem.contact.fe.results import GAUSS_2X2, FEResults, read_results
+from tribodem.contact.fe.results import GAUSS_2X2, FEResults, ip_coordinates, read_results
 from tribodem.contact.geometry import cylinder, flat, line_window
 from tribodem.contact.halfspace import max_shear, von_mises
+from tribodem.io.results import write_csv
+from tribodem.materials.en24t import EN24T
 
 #: default element size at the contact / Hertz half-width of the backend: a/4 (p0 within
 #: 0.14 %, a within 1.2 % in the convergence study; a/8 costs about 4x more per cycle at
 #: large strokes with node-to-surface contact, docs/fe.md)
 FRETTING_H_OVER_A = 0.25
 
-#: modes of :class:`FEContactSolver` (``chained`` is not implemented yet: docs/fe.md)
-MODES = ("fresh",)
+#: modes of :class:`FEContactSolver`: ``fresh`` (one job per cycle, virgin bodies: the
+#: seed's way) and ``chained`` (cycles continue in one job while the geometry is unchanged)
+MODES = ("fresh", "chained")
+#: materials of :class:`FEContactSolver`: elastic, or bilinear elastic-plastic (``*PLASTIC``)
+MATERIALS = ("elastic", "elastic-plastic")
+#: plastic runs: the smallest number of cycle increments ccx may take per cycle, and the
+#: load increments and the normal penalty factor (docs/fe.md, "Elastic-plastic cycles":
+#: 10 E/h and >= 32 cycle increments converge where 50 E/h and 16 stalled)
+PLASTIC_MIN_INCREMENTS = 32
+PLASTIC_LOAD_INCREMENTS = 10
+PLASTIC_PENALTY = 10.0
+#: ccx element node order (-1,-1), (1,-1), (1,1), (-1,1) -> the nearest of the 2x2 Gauss
+#: points (:data:`GAUSS_2X2` order (-,-), (+,-), (-,+), (+,+))
+_NEAREST_GAUSS = np.array([0, 1, 3, 2])
 
 #: nodal values of a bilinear quadrilateral from its 2x2 Gauss-point values: the inverse of
 #: N_i at the Gauss points (ccx order of :data:`GAUSS_2X2`), [4 nodes, 4 points]
 _EXTRAPOLATE = np.linalg.inv(np.array([[0.25 * (1 + xi * xn) * (1 + eta * en)
                                         for xn, en in ((-1, -1), (1, -1), (1, 1), (-1, 1))]
                                        for xi, eta in GAUSS_2X2]))
+
+
+def _digest(key: tuple[bytes, bytes]) -> str:
+    """A short fingerprint of a geometry key (the column wear of both bodies)."""
+    return hashlib.sha1(key[0] + key[1]).hexdigest()
 
 
 def _second_difference(f: Recession, h: float) -> float:
@@ -133,6 +155,7 @@ class JobRecord:
     seconds_ccx: float  #: ccx wall clock (all attempts), s
     seconds_read: float  #: reading the .dat and recovering the tractions, s
     seconds_map: float = 0.0  #: mapping the fields to the window, s
+    cycles: int = 1  #: cycles after the loading in the job (chained mode: > 1)
     worn_area_upper: float = 0.0  #: worn area of the morphed pad, m^2 per m
     worn_area_lower: float = 0.0  #: worn area of the morphed flat, m^2 per m
 
@@ -154,9 +177,44 @@ class FEContactSolver(FirstBodySolver):
     folder). ``regime`` and ``tolerance``
     are the half-space's options and are not used (the FE interface always has partial slip
     and its own Newton tolerances).
+
+    ``material``: ``"elastic"`` or ``"elastic-plastic"`` (both bodies bilinear isotropic
+    hardening, ``*PLASTIC``: ``yield_strength``, ``uts``, ``uts_strain`` (Pa, Pa, -) of seed
+    table 5.1, or a plastic modulus ``hardening`` h in Pa; the tamaas EPIC grid options
+    ``ep_*``, ``load_steps`` are accepted and not used: the mesh is the grid). Plastic jobs
+    take >= 32 cycle increments, 10 load increments and a 10 E/h penalty (docs/fe.md).
+
+    ``mode``: ``"fresh"`` (every cycle one job on virgin bodies) or ``"chained"``: a job runs
+    ``chain_cycles`` cycles on the same bodies, so plastic strain and residual stress carry
+    over, and serves them one by one while the geometry does not change; when they are used
+    up the job is run again from the chain's start with ``chain_cycles`` more; a changed
+    geometry (material removed) starts a new chain on virgin bodies (counted in
+    :meth:`report`: carrying the plastic state onto a morphed mesh is not done).
     """
 
-    capabilities = Capabilities(partial_slip=True, subsurface=True, contacts=("line",))
+    #: every capability some configuration gives; an instance's own are
+    #: :meth:`capabilities_for` its ``material`` and ``mode``
+    capabilities = Capabilities(plastic=True, plastic_every_cycle=True, partial_slip=True,
+                                subsurface=True, contacts=("line",))
+
+    @classmethod
+    def capabilities_for(cls, options: dict[str, Any]) -> Capabilities:
+        """``plastic`` with ``material = "elastic-plastic"``; ``plastic_every_cycle`` only
+        in ``chained`` mode (a fresh job restarts from virgin material every cycle, so its
+        plastic strain would be the first cycle's again and again)."""
+        plastic = options.get("material", "elastic") == "elastic-plastic"
+        chained = options.get("mode", "fresh") == "chained"
+        return Capabilities(plastic=plastic, plastic_every_cycle=plastic and chained,
+                            partial_slip=True, subsurface=True, contacts=("line",))
+
+    @classmethod
+    def options_for(cls, names: set[str]) -> str:
+        opts = []
+        if names & {"plastic", "plastic_every_cycle"}:
+            opts.append("fe.material = 'elastic-plastic'")
+        if "plastic_every_cycle" in names:
+            opts.append("fe.mode = 'chained'")
+        return " and ".join(opts)
 
     def __init__(
         self,
@@ -173,6 +231,12 @@ class FEContactSolver(FirstBodySolver):
         amplitude: float = 0.1e-3,
         n_increments: int = 16,
         mode: str = "fresh",
+        material: str = "elastic",
+        chain_cycles: int = 5,
+        yield_strength: float = EN24T.yield_strength,
+        uts: float = EN24T.uts,
+        uts_strain: float = EN24T.uts_strain,
+        hardening: float | None = None,
         h_over_a: float = FRETTING_H_OVER_A,
         size_factor: float = 40.0,
         threads: int = 1,
@@ -183,8 +247,16 @@ class FEContactSolver(FirstBodySolver):
         stress_depth: float | None = None,
         regime: str = "gross",
         tolerance: float | None = None,
+        ep_n: int | None = None,
+        ep_nz: int | None = None,
+        ep_window_radii: float | None = None,
+        ep_depth_radii: float | None = None,
+        load_steps: int | None = None,
+        ep_tolerance: float | None = None,
     ) -> None:
-        del regime, tolerance  # half-space options (see the class docstring)
+        # half-space and EPIC-grid options (see the class docstring)
+        del regime, tolerance, ep_n, ep_nz, ep_window_radii, ep_depth_radii, load_steps
+        del ep_tolerance
         if (upper is None) != (lower is None):
             raise ValueError("upper and lower must both be given or both be None (defaults)")
         if upper is None or lower is None:
@@ -194,7 +266,22 @@ class FEContactSolver(FirstBodySolver):
                              "line contact only (2D plane strain); allowed: 'line'")
         if mode not in MODES:
             raise ValueError(f"mode = {mode!r} is not allowed: allowed: {', '.join(MODES)}")
+        if material not in MATERIALS:
+            raise ValueError(f"material = {material!r} is not allowed: allowed: "
+                             f"{', '.join(MATERIALS)}")
+        if int(chain_cycles) != chain_cycles or chain_cycles < 1:
+            raise ValueError(f"chain_cycles = {chain_cycles!r} is not allowed: an integer >= 1")
         self.mode = mode
+        self.material = material
+        self.plastic = material == "elastic-plastic"
+        self.chain_cycles = int(chain_cycles)
+        self.capabilities = self.capabilities_for({"material": material, "mode": mode})
+        self.plastic_law = FEMaterial(
+            yield_strength=_check_positive("yield_strength", yield_strength),
+            uts=_check_positive("uts", uts), uts_strain=_check_positive("uts_strain", uts_strain),
+            hardening=hardening)
+        if self.plastic:
+            self.plastic_law.plastic_table()  # ValueError on an impossible law
         self.executable = find_ccx(executable)  # CcxNotFoundError names the install command
         self.upper, self.lower = upper, lower
         self._base_upper, self._base_lower = upper, lower
@@ -252,14 +339,24 @@ class FEContactSolver(FirstBodySolver):
                              if stress_depth is not None else
                              max(4.0 * a, 4.5 * math.sqrt(2.0 * a * self.window / math.pi)))
         self.settings = sliding_contact(self.friction, self.hertz[0])
+        if self.plastic:
+            self.settings = replace(self.settings, penalty_factor=PLASTIC_PENALTY)
         self.jobs: list[JobRecord] = []  #: every ccx job run, in order
         self._mesh0 = self._base_mesh()
+        self._job_key: tuple[bytes, bytes] | None = None
         self.reset()
         self._cycle = 0  # cycles served (the job folder's number is the next one)
-        self._job_key: tuple[bytes, bytes] | None = None
         self._served: list[IncrementResult] = []
-        self._loaded_result: IncrementResult | None = None
         self.mesh: Mesh = self._mesh0  #: the (morphed) mesh of the last job
+        self._job_cycles = 0  # cycles of the last job
+        self._chain_start = 1  # the fretting cycle the last job's first cycle served
+        self._pos = 0  # cycles of the last job served
+        self._loading_pended = False
+        self._pending: list[PlasticStep] = []
+        self._nodal_cache: dict[tuple[str, float], NDArray[np.float64]] = {}
+        self._peeq_cache: dict[tuple[str, float], NDArray[np.float64]] = {}
+        self.chain_restarts = 0  #: chained mode: chains restarted because the geometry changed
+        self.cycle_reports: list[dict[str, Any]] = []  #: :meth:`_cycle_report` per cycle
 
     # -- geometry -------------------------------------------------------------------------
     @property
@@ -274,7 +371,18 @@ class FEContactSolver(FirstBodySolver):
 
     def _materials(self) -> tuple[FEMaterial, FEMaterial]:
         lo, up = self.lower_material, self.upper_material
-        return FEMaterial(lo.young, lo.poisson), FEMaterial(up.young, up.poisson)
+        law = self.plastic_law
+        y = law.yield_strength if self.plastic else None
+        return tuple(FEMaterial(b.young, b.poisson, yield_strength=y, uts=law.uts,  # type: ignore[return-value]
+                                uts_strain=law.uts_strain, hardening=law.hardening)
+                     for b in (lo, up))
+
+    @property
+    def plastic_depth(self) -> float:
+        """Depth of the grid of :meth:`plastic_steps`, m: 2 Hertz half-widths (the plastic
+        zone of a Hertz line contact with friction lies within ~a of the surface), at most
+        the printed column depth."""
+        return min(2.0 * self.hertz[1], self.stress_depth)
 
     def _base_mesh(self) -> Mesh:
         """The unworn mesh, with the element sets ``UCOL``/``LCOL`` of the node columns under
@@ -346,20 +454,43 @@ class FEContactSolver(FirstBodySolver):
 
     # -- the contract ---------------------------------------------------------------------
     def reset(self) -> None:
-        """Forget the load history: the next ``solve_increment(0.0)`` is a first loading."""
+        """Forget the load history: the next ``solve_increment(0.0)`` is a first loading
+        (in ``chained`` mode on virgin bodies: a new chain)."""
         self._k: int | None = None  # next increment of the cycle in progress (None: none)
         self._loaded = False
+        if self.mode == "chained":
+            self._job_key = None
 
     def begin_cycle(self) -> None:
-        """Run this cycle's ccx job on the current surfaces (unless the last job was on the
-        same geometry and has served only the first loading)."""
+        """Make this cycle's increments: a new ccx job on the current surfaces, or (fresh
+        mode, first cycle) the loading's job, or (chained mode, same geometry) the next
+        cycle of the chain's job."""
         self._start_cycle()
 
     def _start_cycle(self) -> None:
         key = self._key()
-        if not (key == self._job_key and self._served and self._fresh_for_cycle):
-            self._run_job()
+        same = key == self._job_key and self.results is not None
+        resume = self._resume_chain
+        self._resume_chain = None
+        if resume is not None and self.mode == "chained" and _digest(key) == resume[0]:
+            pos, cycles = resume[1] + 1, resume[2]  # replay the chain, as long as it was
+            self._run_job(cycles if pos <= cycles else cycles + self.chain_cycles,
+                          chain_start=resume[3])
+        elif self._fresh_for_cycle and same:
+            pos = 1
+        elif self.mode == "chained" and same and self._pos < self._job_cycles:
+            pos = self._pos + 1
+        elif self.mode == "chained" and same:  # the chain's job is used up: run it longer
+            pos = self._pos + 1
+            self._run_job(self._job_cycles + self.chain_cycles, chain_start=self._chain_start)
+        else:
+            if self.mode == "chained" and (self._job_key is not None or resume is not None):
+                self.chain_restarts += 1  # the geometry changed: virgin bodies again
+            self._run_job(self.chain_cycles if self.mode == "chained" else 1,
+                          chain_start=self._cycle + 1)
+            pos = 1
         self._fresh_for_cycle = False
+        self._serve_cycle(pos)
         self._cycle += 1
         self._k = 0
 
@@ -375,12 +506,12 @@ class FEContactSolver(FirstBodySolver):
         if self._k is None:
             if offset == 0.0 and not self._loaded:
                 key = self._key()
-                if key != self._job_key or not self._served:
-                    self._run_job()
+                if key != self._job_key or self.results is None:
+                    self._run_job(self.chain_cycles if self.mode == "chained" else 1,
+                                  chain_start=self._cycle + 1)
                 self._fresh_for_cycle = True  # the first cycle may reuse this job
                 self._loaded = True
-                assert self._loaded_result is not None
-                return self._loaded_result
+                return self._serve_loading()
             self._start_cycle()
         assert self._k is not None
         expected = float(self.offsets[self._k])
@@ -399,14 +530,18 @@ class FEContactSolver(FirstBodySolver):
 
     # -- the job ---------------------------------------------------------------------------
     _fresh_for_cycle = False
+    results: FEResults | None = None  #: the parsed results of the last job
+    _resume_chain: tuple[str, int, int, int] | None = None
 
     def _folder(self) -> Path:
         if self.workdir is None:
             self.workdir = Path(tempfile.mkdtemp(prefix="tribodem-fe-"))
         return self.workdir / f"cycle_{self._cycle + 1:04d}"
 
-    def _run_job(self) -> None:
-        """Mesh, morph, write, run (retrying with smaller increments) and read one job."""
+    def _run_job(self, cycles: int = 1, chain_start: int = 1) -> None:
+        """Mesh, morph, write, run (retrying with smaller increments) and read one job of
+        ``cycles`` cycles after the loading; ``chain_start``: the fretting cycle its first
+        cycle serves."""
         t0 = time.perf_counter()
         folder = self._folder()
         folder.mkdir(parents=True, exist_ok=True)
@@ -417,13 +552,15 @@ class FEContactSolver(FirstBodySolver):
         t_ccx = 0.0
         run: CcxRun | None = None
         refine = 1
+        base = math.ceil(PLASTIC_MIN_INCREMENTS / self.n_increments) if self.plastic else 1
         for attempt in range(self.retries + 1):
-            refine = 2**attempt
+            refine = base * 2**attempt
             t1 = time.perf_counter()
             case = LoadCase(load=self.load_per_length, delta=self.amplitude,
                             n_increments=self.n_increments, seat=seat, refine=refine,
-                            split_cycle=True)
-            name = "job" if refine == 1 else f"job_refine{refine}"
+                            split_cycle=True, cycles=int(cycles), unload=self.plastic,
+                            load_increments=PLASTIC_LOAD_INCREMENTS if self.plastic else 5)
+            name = "job" if attempt == 0 else f"job_refine{refine}"
             deck = write_deck(folder / f"{name}.inp", mesh, case, lower, upper, self.settings,
                               fine_stress=False, stress_sets=("LCOL", "UCOL"))
             t_mesh += time.perf_counter() - t1
@@ -444,120 +581,182 @@ class FEContactSolver(FirstBodySolver):
         t_read = time.perf_counter() - t3
         rec = JobRecord(cycle=self._cycle + 1, folder=folder, deck=run.job.with_suffix(".inp"),
                         elements=mesh.n_elements, refine=refine, seconds_mesh=t_mesh,
-                        seconds_ccx=t_ccx, seconds_read=t_read,
+                        seconds_ccx=t_ccx, seconds_read=t_read, cycles=int(cycles),
                         worn_area_upper=mesh_worn_area(self._mesh0, mesh, "upper"),
                         worn_area_lower=mesh_worn_area(self._mesh0, mesh, "lower"))
-        t4 = time.perf_counter()
-        self._serve(res, mesh)
-        rec.seconds_map = time.perf_counter() - t4
         self.mesh = mesh
-        self.results = res  #: the parsed results of the last job
+        self.results = res
         self._job_key = self._key()
+        self._job_cycles = int(cycles)
+        self._chain_start = int(chain_start)
+        self._pos = 0
+        self._loading_pended = False
+        self._nodal_cache = {}
+        self._peeq_cache = {}
+        self._time_of = {}  # total time of each increment served from this job
         self.jobs.append(rec)
-        self._write_profile(rec)
+        self._write_profile()
 
-    def _write_profile(self, rec: JobRecord) -> None:
+    _prior_jobs: list[list[str]] | None = None
+    _JOB_COLUMNS = ("cycle", "cycles", "elements", "refine", "seconds_mesh", "seconds_ccx",
+                    "seconds_read", "seconds_map", "worn_volume_upper_m3",
+                    "worn_volume_lower_m3", "deck")
+
+    def _write_profile(self) -> None:
+        """``workdir/jobs.csv``: one row per job (with the rows of an earlier session of a
+        resumed run), rewritten atomically whenever a job is run or its fields are mapped."""
         assert self.workdir is not None
         path = self.workdir / "jobs.csv"
-        row = {"cycle": rec.cycle, "elements": rec.elements, "refine": rec.refine,
-               "seconds_mesh": f"{rec.seconds_mesh:.4f}", "seconds_ccx": f"{rec.seconds_ccx:.3f}",
-               "seconds_read": f"{rec.seconds_read:.4f}", "seconds_map": f"{rec.seconds_map:.4f}",
-               "worn_volume_upper_m3": f"{rec.worn_area_upper * self.window:.9e}",
-               "worn_volume_lower_m3": f"{rec.worn_area_lower * self.window:.9e}",
-               "deck": str(rec.deck)}
-        new = not path.exists()
-        with open(path, "a", newline="") as fh:
-            w = csv.DictWriter(fh, fieldnames=list(row))
-            if new:
-                w.writeheader()
-            w.writerow(row)
+        if self._prior_jobs is None:
+            self._prior_jobs = []
+            if path.exists():
+                with open(path, newline="") as fh:
+                    rows = list(csv.reader(fh))
+                if rows and tuple(rows[0]) == self._JOB_COLUMNS:
+                    self._prior_jobs = rows[1:]
+        rows = [[rec.cycle, rec.cycles, rec.elements, rec.refine, f"{rec.seconds_mesh:.4f}",
+                 f"{rec.seconds_ccx:.3f}", f"{rec.seconds_read:.4f}", f"{rec.seconds_map:.4f}",
+                 f"{rec.worn_area_upper * self.window:.9e}",
+                 f"{rec.worn_area_lower * self.window:.9e}", str(rec.deck)]
+                for rec in self.jobs]
+        write_csv(path, self._JOB_COLUMNS, self._prior_jobs + rows)
 
-    def _times(self, res: FEResults) -> list[int]:
-        """Indices of the loaded state (total time 2) and of the cycle's n increments."""
-        want = np.concatenate([[2.0], 2.0 + 4.0 * np.arange(1, self.n_increments + 1)
-                               / self.n_increments])
-        idx = []
-        for t in want:
-            k = int(np.argmin(np.abs(res.times - t)))
-            if abs(res.times[k] - t) > 1e-6:
-                raise FESolverStopped(f"ccx output has no result at total time {t:g} (deck "
-                                      f"{self.jobs[-1].deck if self.jobs else '?'})")
-            idx.append(k)
-        return idx
+    def _time_index(self, t: float) -> int:
+        assert self.results is not None
+        k = int(np.argmin(np.abs(self.results.times - t)))
+        if abs(self.results.times[k] - t) > 1e-6:
+            raise FESolverStopped(f"ccx output has no result at total time {t:g} (deck "
+                                  f"{self.jobs[-1].deck if self.jobs else '?'})")
+        return k
 
-    def _serve(self, res: FEResults, mesh: Mesh) -> None:
-        """Map the job's surface fields to the window: the loaded state and the increments."""
-        idx = self._times(res)
-        c = self.coords
-        dx = self.dx
-        n = self.n
-        ubot = mesh.node_sets["UBOT"]
-        ltop = mesh.node_sets["LTOP"]
-        xu0 = mesh.nodes[ubot - 1, 0]
-        ou = np.argsort(xu0)
-        ubot, xu0 = ubot[ou], xu0[ou]
-        xl0 = mesh.nodes[ltop - 1, 0]
-        ol = np.argsort(xl0)
-        ltop, xl0 = ltop[ol], xl0[ol]
-        disp = {(b.set_name, b.time): b.rows for b in res.dat if b.kind == "displacements"}
+    def _cycle_times(self, pos: int) -> NDArray[np.float64]:
+        """Total times of the ends of cycle ``pos``'s increments (the job's cycle ``pos``,
+        1-based, starts at 2 + 4 (pos - 1))."""
+        return 2.0 + 4.0 * (pos - 1) + 4.0 * np.arange(1, self.n_increments + 1) \
+            / self.n_increments
 
-        def ux(set_name: str, ids: NDArray[np.int64], t: float) -> NDArray[np.float64]:
-            rows = disp[(set_name, t)]
-            lookup = {int(k): j for j, k in enumerate(rows[:, 0])}
-            return np.array([rows[lookup[int(k)], 1] for k in ids])
+    def _surface_nodes(self) -> tuple[NDArray[np.int64], NDArray[np.float64],
+                                      NDArray[np.int64], NDArray[np.float64]]:
+        """The pad's (UBOT) and the flat's (LTOP) surface nodes sorted by x, and their x."""
+        mesh = self.mesh
+        ubot, ltop = mesh.node_sets["UBOT"], mesh.node_sets["LTOP"]
+        xu0, xl0 = mesh.nodes[ubot - 1, 0], mesh.nodes[ltop - 1, 0]
+        ou, ol = np.argsort(xu0), np.argsort(xl0)
+        return ubot[ou], xu0[ou], ltop[ol], xl0[ol]
 
-        k_t = self.settings.stick_factor * self.settings.penalty_factor * min(
-            self.upper_material.young, self.lower_material.young) / mesh.h_fine
+    def _displacement(self, set_name: str, ids: NDArray[np.int64], t: float,
+                      comp: int = 1) -> NDArray[np.float64]:
+        """Displacement component ``comp`` (1: x, 2: y) of nodes ``ids`` at total time ``t``."""
+        assert self.results is not None
+        key = (set_name, t)
+        if self._disp is None or self._disp_of is not self.results:
+            self._disp = {(b.set_name, b.time): b.rows for b in self.results.dat
+                          if b.kind == "displacements"}
+            self._disp_of = self.results
+        rows = self._disp[key]
+        order = np.argsort(rows[:, 0])
+        j = order[np.searchsorted(rows[order, 0], ids)]
+        return rows[j, comp]
+
+    _disp: dict[tuple[str, float], NDArray[np.float64]] | None = None
+    _disp_of: FEResults | None = None
+
+    def _increment(self, t: float, prev_t: float | None, off: float, start: float
+                   ) -> IncrementResult:
+        """The window fields at total time ``t``; ``prev_t`` None: the loading (no slip)."""
+        assert self.results is not None
+        n, dx, c = self.n, self.dx, self.coords
+        ubot, xu0, ltop, xl0 = self._surface_nodes()
+        st = self.results.contact[self._time_index(t)]
+        # recovered nodal tractions carry round-off of the 7 printed digits (~1e-7 p0):
+        # nodes below 1e-5 of the peak pressure are out of contact
+        p_node = np.where(st.pressure > 1e-5 * st.pressure.max(), st.pressure, 0.0)
+        q_node = np.where(p_node > 0.0, st.shear, 0.0)
+        p = cell_average(xu0, p_node, c, dx)
+        q = cell_average(xu0, q_node, c, dx)
+        contact_x = p > 0.0
+        if p[0] > 0.0 or p[-1] > 0.0:
+            raise WindowTooSmallError(
+                f"the FE contact reaches the window edge (window {self.window:.4g} m, n "
+                f"{n}): enlarge contact.window")
+        if prev_t is None:
+            slip_x = np.zeros(n)
+            q = np.zeros(n)  # the loading: no sliding (friction 0.001 while loading)
+            stick = None
+            direction = 0.0
+        else:
+            k_t = self.settings.stick_factor * self.settings.penalty_factor * min(
+                self.upper_material.young, self.lower_material.young) / self.mesh.h_fine
+            u_up0 = self._displacement("UBOT", ubot, prev_t)
+            u_up1 = self._displacement("UBOT", ubot, t)
+            u_lo0 = self._displacement("LTOP", ltop, prev_t)
+            u_lo1 = self._displacement("LTOP", ltop, t)
+            x_flat = xu0 + u_up0 - np.interp(xu0 + u_up0, xl0, u_lo0)
+            du_lo = np.interp(x_flat, xl0, u_lo1) - np.interp(x_flat, xl0, u_lo0)
+            s_node = np.where(p_node > 0.0, (u_up1 - u_up0) - du_lo, 0.0)
+            slip_x = np.where(contact_x, np.interp(c, xu0, s_node), 0.0)
+            stick_node = (p_node > 0.0) & (np.abs(s_node) <= self.friction * p_node / k_t)
+            stick = np.interp(c, xu0, stick_node.astype(float)) > 0.5
+            stick = np.repeat((stick & contact_x)[:, None], n, axis=1)
+            direction = math.copysign(1.0, off - start)
+        p2 = np.repeat(p[:, None], n, axis=1)
+        traction = np.zeros((n, n, 2))
+        traction[..., 0] = q[:, None]
+        slip = np.zeros((n, n, 2))
+        slip[..., 0] = slip_x[:, None]
         cell = dx * dx
-        out: list[IncrementResult] = []
-        prev_t = float(res.times[idx[0]])
-        for j, k in enumerate(idx):
-            st = res.contact[k]
-            t = float(res.times[k])
-            # recovered nodal tractions carry round-off of the 7 printed digits (~1e-7 p0):
-            # nodes below 1e-5 of the peak pressure are out of contact
-            p_node = np.where(st.pressure > 1e-5 * st.pressure.max(), st.pressure, 0.0)
-            q_node = np.where(p_node > 0.0, st.shear, 0.0)
-            p = cell_average(xu0, p_node, c, dx)
-            q = cell_average(xu0, q_node, c, dx)
-            contact_x = p > 0.0
-            if p[0] > 0.0 or p[-1] > 0.0:
-                raise WindowTooSmallError(
-                    f"the FE contact reaches the window edge (window {self.window:.4g} m, n "
-                    f"{n}): enlarge contact.window")
-            if j == 0:
-                slip_x = np.zeros(n)
-                q = np.zeros(n)  # the loading: no sliding (friction 0.001 while loading)
-                stick = None
-                start, off, direction = 0.0, 0.0, 0.0
-            else:
-                u_up0, u_up1 = ux("UBOT", ubot, prev_t), ux("UBOT", ubot, t)
-                u_lo0_all, u_lo1_all = ux("LTOP", ltop, prev_t), ux("LTOP", ltop, t)
-                x_flat = xu0 + u_up0 - np.interp(xu0 + u_up0, xl0, u_lo0_all)
-                du_lo = np.interp(x_flat, xl0, u_lo1_all) - np.interp(x_flat, xl0, u_lo0_all)
-                s_node = (u_up1 - u_up0) - du_lo
-                s_node = np.where(p_node > 0.0, s_node, 0.0)
-                slip_x = np.where(contact_x, np.interp(c, xu0, s_node), 0.0)
-                stick_node = (p_node > 0.0) & (np.abs(s_node) <= self.friction * p_node / k_t)
-                stick = np.interp(c, xu0, stick_node.astype(float)) > 0.5
-                stick = np.repeat((stick & contact_x)[:, None], n, axis=1)
-                off = float(self.offsets[j - 1])
-                start = float(self.offsets[j - 2]) if j >= 2 else 0.0
-                direction = math.copysign(1.0, off - start)
-            prev_t = t
-            p2 = np.repeat(p[:, None], n, axis=1)
-            traction = np.zeros((n, n, 2))
-            traction[..., 0] = q[:, None]
-            slip = np.zeros((n, n, 2))
-            slip[..., 0] = slip_x[:, None]
-            out.append(IncrementResult(
-                offset=off, start_offset=start, direction=direction, pressure=p2,
-                traction=traction, slip=slip, contact_area=float(contact_x.sum()) * n * cell,
-                normal_load=float(p2.sum()) * cell, stick=stick))
-        self._loaded_result = out[0]
-        self._served = out[1:]
-        self._time_of = {id(inc): float(res.times[k]) for inc, k in zip(out, idx, strict=True)}
-        self._nodal_cache: dict[tuple[str, float], NDArray[np.float64]] = {}
+        inc = IncrementResult(
+            offset=off, start_offset=start, direction=direction, pressure=p2,
+            traction=traction, slip=slip, contact_area=float(contact_x.sum()) * n * cell,
+            normal_load=float(p2.sum()) * cell, stick=stick)
+        self._time_of[id(inc)] = t
+        return inc
+
+    def _loading_times(self) -> NDArray[np.float64]:
+        assert self.results is not None
+        t = self.results.times
+        return t[(t > 1.0 + 1e-9) & (t <= 2.0 + 1e-9)]
+
+    def _serve_loading(self) -> IncrementResult:
+        """The loaded state (total time 2) of the current job; its plastic steps pended."""
+        t0 = time.perf_counter()
+        inc = self._increment(2.0, None, 0.0, 0.0)
+        self._pend_loading()
+        self._add_map_time(time.perf_counter() - t0)
+        return inc
+
+    def _pend_loading(self) -> None:
+        if self.plastic and not self._loading_pended:
+            prev: float | None = None
+            for t in self._loading_times():
+                self._pending.extend(self._plastic_step(float(t), prev))
+                prev = float(t)
+        self._loading_pended = True
+
+    def _serve_cycle(self, pos: int) -> None:
+        """Map cycle ``pos`` of the current job to the window (and its plastic steps)."""
+        t0 = time.perf_counter()
+        if pos == 1:
+            self._pend_loading()  # a job's first cycle comes with its loading
+        times = self._cycle_times(pos)
+        prev = 2.0 + 4.0 * (pos - 1)
+        out = []
+        for j, t in enumerate(times):
+            off = float(self.offsets[j])
+            start = float(self.offsets[j - 1]) if j >= 1 else 0.0
+            out.append(self._increment(float(t), prev, off, start))
+            if self.plastic:
+                self._pending.extend(self._plastic_step(float(t), prev))
+            prev = float(t)
+        self._served = out
+        self._pos = pos
+        self.cycle_reports.append(self._cycle_report(pos, out))
+        self._add_map_time(time.perf_counter() - t0)
+
+    def _add_map_time(self, seconds: float) -> None:
+        if self.jobs:
+            self.jobs[-1].seconds_map += seconds
+            self._write_profile()
 
     # -- subsurface stress ----------------------------------------------------------------
     _time_of: dict[int, float] = {}
@@ -596,6 +795,43 @@ class FEContactSolver(FirstBodySolver):
             self._nodal_cache = {key: nodal_avg}
         return self._nodal_cache[key]
 
+    def _column_field(self, body: str, nodal: NDArray[np.float64], x: NDArray[np.float64],
+                      z: NDArray[np.float64], what: str = "stresses") -> NDArray[np.float64]:
+        """Nodal values ``nodal`` [n_nodes, C] (NaN off the printed columns) on the grid
+        (depth ``z`` below the worn surface, ``x`` in the body's mesh frame), [nz, nx, C]:
+        linear along each straight node column by the depth below its surface node, then
+        linear between columns."""
+        cols = self.mesh.columns[body]
+        xs = self.mesh.nodes[cols[:, 0], 0]
+        j = np.clip(np.searchsorted(xs, x, side="right") - 1, 0, xs.size - 2)
+        w = np.clip((x - xs[j]) / (xs[j + 1] - xs[j]), 0.0, 1.0)
+        need = np.unique(np.concatenate([j, j + 1]))
+        prof = np.zeros((xs.size, z.size, nodal.shape[1]))
+        for c in need:
+            nodes = cols[c]
+            d = np.abs(self.mesh.nodes[nodes, 1] - self.mesh.nodes[nodes[0], 1])
+            v = nodal[nodes]
+            ok = np.isfinite(v[:, 0])
+            if not ok[0] or d[ok].max() < z[-1] * (1 - 1e-9):
+                raise ValueError(f"no column {what} under x = {xs[c]:.4g} m down to depth "
+                                 f"{z[-1]:.4g} m on the {body} body")
+            prof[c] = np.stack([np.interp(z, d[ok], v[ok, k]) for k in range(v.shape[1])],
+                               axis=-1)
+        out = (1 - w)[:, None, None] * prof[j] + w[:, None, None] * prof[j + 1]
+        return np.moveaxis(out, 0, 1)  # [nz, nx, C]
+
+    @staticmethod
+    def _voigt(s2: NDArray[np.float64], body: str) -> NDArray[np.float64]:
+        """FE (sxx, sYY, szz, sxY) [..., 4] -> the contract's Voigt stress [..., 6] (x, y =
+        the cylinder's axis, z = depth into the body: sigma_xz = -sxY under the flat)."""
+        sign = -1.0 if body == "lower" else 1.0
+        voigt = np.zeros(s2.shape[:-1] + (6,))
+        voigt[..., 0] = s2[..., 0]
+        voigt[..., 1] = s2[..., 2]
+        voigt[..., 2] = s2[..., 1]
+        voigt[..., 4] = sign * s2[..., 3]
+        return voigt
+
     def subsurface_stress(self, result: IncrementResult, body: Body = "lower",
                           depth: float | None = None, nz: int = 33) -> SubsurfaceStress:
         """Stress under ``body`` for an increment this solver served (the current cycle's
@@ -623,53 +859,186 @@ class FEContactSolver(FirstBodySolver):
             raise ValueError(f"depth = {depth!r} m is not allowed: the fe solver prints the "
                              f"column stresses down to {self.stress_depth:.4g} m "
                              "(its stress_depth; wear.stress_depth of a fretting config)")
-        nodal = self._nodal_stress(body, t)
-        cols = self.mesh.columns[body]
-        xs = self.mesh.nodes[cols[:, 0], 0]
         x = self.coords + (result.offset if body == "lower" else 0.0)
         z = np.linspace(0.0, depth, int(nz))
-        j = np.clip(np.searchsorted(xs, x, side="right") - 1, 0, xs.size - 2)
-        w = np.clip((x - xs[j]) / (xs[j + 1] - xs[j]), 0.0, 1.0)
-        need = np.unique(np.concatenate([j, j + 1]))
-        prof = {}
-        for c in need:
-            nodes = cols[c]
-            d = np.abs(self.mesh.nodes[nodes, 1] - self.mesh.nodes[nodes[0], 1])
-            v = nodal[nodes]
-            ok = np.isfinite(v[:, 0])
-            if not ok[0] or d[ok].max() < depth * (1 - 1e-9):
-                raise ValueError(f"no column stresses under x = {xs[c]:.4g} m down to depth "
-                                 f"{depth:.4g} m on the {body} body")
-            prof[c] = np.stack([np.interp(z, d[ok], v[ok, k]) for k in range(4)], axis=-1)
-        s2 = np.stack([(1 - w[i]) * prof[j[i]] + w[i] * prof[j[i] + 1]
-                       for i in range(x.size)], axis=1)  # [nz, n, 4] FE components
-        sign = -1.0 if body == "lower" else 1.0
-        voigt = np.zeros((int(nz), self.n, 6))
-        voigt[..., 0] = s2[..., 0]
-        voigt[..., 1] = s2[..., 2]
-        voigt[..., 2] = s2[..., 1]
-        voigt[..., 4] = sign * s2[..., 3]
+        voigt = self._voigt(self._column_field(body, self._nodal_stress(body, t), x, z), body)
         stress = np.repeat(voigt[:, :, None, :], self.n, axis=2)
         return SubsurfaceStress(body=body, z=z, x=self.coords, y=self.coords, stress=stress,
                                 von_mises=von_mises(stress), tresca=max_shear(stress))
 
+    # -- plastic strain (material = "elastic-plastic") --------------------------------------
+    def _nodal_peeq(self, body: str, t: float) -> NDArray[np.float64]:
+        """Equivalent plastic strain at the nodes at total time ``t``, [n_nodes, 1] (NaN
+        off the column set): each node takes the mean, over the elements around it, of
+        the element's Gauss point nearest to it (no extrapolation: >= 0, no overshoot at
+        the surface where plastic strain is steepest)."""
+        key = (body, t)
+        if key not in self._peeq_cache:
+            assert self.results is not None
+            elems, ip = self.results.peeq(t, "LCOL" if body == "lower" else "UCOL")
+            conn = self.mesh.elements[elems - 1]
+            total = np.zeros(self.mesh.n_nodes)
+            count = np.zeros(self.mesh.n_nodes)
+            np.add.at(total, conn, ip[:, _NEAREST_GAUSS])
+            np.add.at(count, conn, 1.0)
+            with np.errstate(invalid="ignore", divide="ignore"):
+                self._peeq_cache[key] = (total / count)[:, None]
+        return self._peeq_cache[key]
+
+    def _plastic_grid_x(self, body: str) -> NDArray[np.float64]:
+        """x of the plastic-step grid: the window (upper, its own frame) or the window plus
+        the stroke (lower, lab frame) at the window spacing, m."""
+        if body == "upper":
+            return self.coords
+        pad = math.ceil(self.amplitude / self.dx) + 1
+        return (np.arange(-pad, self.n + pad) - self.n // 2) * self.dx
+
+    def _plastic_step(self, t: float, prev_t: float | None) -> list[PlasticStep]:
+        """The plastic step ending at total time ``t`` from ``prev_t`` (None: from the
+        virgin state), one per body, on [33, nx, 2] grids (constant along the cylinder's
+        axis y; the two y points span the window twice)."""
+        z = np.linspace(0.0, self.plastic_depth, 33)
+        y = np.array([-self.window, self.window])
+        k = self._time_index(t)
+        assert self.results is not None
+        load = float(abs(self.results.normal_force[k])) * self.window
+        steps = []
+        for body in BODIES:
+            x = self._plastic_grid_x(body)
+            now = self._nodal_peeq(body, t)
+            dp_nodal = now if prev_t is None else now - self._nodal_peeq(body, prev_t)
+            dp = np.maximum(self._column_field(body, dp_nodal, x, z, "plastic strain")[..., 0],
+                            0.0)
+            stress = self._voigt(self._column_field(body, self._nodal_stress(body, t), x, z),
+                                 body)
+            steps.append(PlasticStep(z=z, x=x, y=y, body=body, load=load,
+                                     dp=np.repeat(dp[:, :, None], 2, axis=2),
+                                     stress=np.repeat(stress[:, :, None, :], 2, axis=2)))
+        return steps
+
+    def plastic_steps(self) -> list[PlasticStep]:
+        """The plastic steps solved since the last call (then forgotten): every output
+        increment of the loading (a job's first cycle) and of the cycles served, one step
+        per body (:attr:`PlasticStep.body`: the upper body's grid in its window frame, the
+        lower body's in the lab frame over the window plus the stroke)."""
+        if not self.plastic:
+            raise Unsupported("the fe solver gives plastic strain with material = "
+                              "'elastic-plastic'")
+        out, self._pending = self._pending, []
+        return out
+
+    # -- what a cycle measured -------------------------------------------------------------
+    def _cycle_report(self, pos: int, incs: list[IncrementResult]) -> dict[str, Any]:
+        """Peak stresses, plastic strain, pile-up and traction of the cycle just served
+        (fretting cycle ``self._cycle + 1``, cycle ``pos`` of its job); see :meth:`report`."""
+        assert self.results is not None
+        res, mesh = self.results, self.mesh
+        t_end = float(self._cycle_times(pos)[-1])
+        times = [float(t) for t in self._cycle_times(pos)]
+        if pos == 1:
+            times = [float(t) for t in self._loading_times()] + times
+        row: dict[str, Any] = {"cycle": self._cycle + 1, "job_cycle": pos}
+        vm_max = s22_c = s22_t = 0.0
+        for set_name in ("UCOL", "LCOL"):
+            for t in times:
+                _, ip = res.ip_stress(t, set_name)
+                s = ip.reshape(-1, 4)
+                vm = np.sqrt(0.5 * ((s[:, 0] - s[:, 1]) ** 2 + (s[:, 1] - s[:, 2]) ** 2
+                                    + (s[:, 2] - s[:, 0]) ** 2) + 3.0 * s[:, 3] ** 2)
+                vm_max = max(vm_max, float(vm.max()))
+                s22_c = max(s22_c, float(-s[:, 1].min()))
+                s22_t = max(s22_t, float(s[:, 1].max()))
+        row |= {"max_von_mises_pa": vm_max, "max_s22_compressive_pa": s22_c,
+                "max_s22_tensile_pa": s22_t}
+        if self.plastic:
+            for body, set_name in (("upper", "UCOL"), ("lower", "LCOL")):
+                elems, pe = res.peeq(t_end, set_name)
+                k = np.unravel_index(int(np.argmax(pe)), pe.shape)
+                xy = ip_coordinates(mesh.nodes[mesh.elements[elems[k[0]] - 1]][None])[0, k[1]]
+                top = mesh.columns[body][:, 0]
+                order = np.argsort(mesh.nodes[top, 0])
+                y_surf = np.interp(xy[0], mesh.nodes[top[order], 0], mesh.nodes[top[order], 1])
+                row[f"max_peeq_{body}"] = float(pe[k])
+                row[f"max_peeq_depth_{body}_m"] = float(abs(xy[1] - y_surf))
+        if self.plastic and pos == self._job_cycles:
+            # the job ends by lifting the pad off: the residual surfaces after the cycle.
+            # Pile-up: the largest rise of the flat's surface above its undeformed level
+            # (and of the pad's surface towards the flat, relative to the pad's top); dent:
+            # the deepest residual depression
+            t_off = t_end + 1.0
+            ubot, _, ltop, _ = self._surface_nodes()
+            k_off = self._time_index(t_off)
+            u_lo = self._displacement("LTOP", ltop, t_off, 2)
+            u_up = self._displacement("UBOT", ubot, t_off, 2) - res.ref_displacement[k_off, 1]
+            row |= {"pile_up_lower_m": float(max(u_lo.max(), 0.0)),
+                    "dent_lower_m": float(max(-u_lo.min(), 0.0)),
+                    "pile_up_upper_m": float(max(-u_up.min(), 0.0)),
+                    "dent_upper_m": float(max(u_up.max(), 0.0))}
+        q = np.array([float(np.abs(i.traction[..., 0]).max()) for i in incs])
+        quarter = max(len(incs) // 4, 1)
+        first, last = float(q[:quarter].max()), float(q[-quarter:].max())
+        row |= {"max_traction_first_quarter_pa": first, "max_traction_last_quarter_pa": last,
+                "traction_drop": (last - first) / first if first > 0 else 0.0}
+        qa = [abs(float(res.tangential_force[self._time_index(times[-1 - 3 * quarter])])),
+              abs(float(res.tangential_force[self._time_index(times[-1 - quarter])]))]
+        row["q_over_mu_p_at_plus_minus_a"] = [v / (self.friction * self.load_per_length)
+                                              for v in qa]
+        return row
+
+    def report(self) -> dict[str, Any]:
+        """For summary.json: mode, material, jobs and their mean time profile, chains
+        restarted, and per served cycle (:meth:`_cycle_report`): max von Mises, max S22
+        (compressive and tensile; the FE's vertical normal stress) over the column sets at
+        every output time of the cycle (and of the loading in a job's first cycle), max
+        equivalent plastic strain per body at the cycle's end and its depth below the
+        surface; for the last cycle of a plastic job, after the pad is lifted off, the
+        residual pile-up (largest rise of the flat's surface above its undeformed level,
+        of the pad's towards the flat) and dent (deepest residual depression); the largest
+        shear traction in
+        the cycle's first and last quarters and the drop between them (last / first - 1),
+        |Q| / (mu P) at +A and -A."""
+        return {"backend": "fe", "mode": self.mode, "material": self.material,
+                "chain_cycles": self.chain_cycles if self.mode == "chained" else None,
+                "chain_restarts": self.chain_restarts, "profile": self.profile(),
+                "cycles": list(self.cycle_reports)}
+
     # -- resume ---------------------------------------------------------------------------
     def state_dict(self) -> dict[str, Any]:
         """Between cycles a fresh-mode solver holds no load history (every cycle is a new job
-        on virgin bodies): the cycle counter, whether the bodies were loaded, and the work
-        folder. The surfaces are set by their owner."""
+        on virgin bodies): the cycle counter, whether the bodies were loaded, the work
+        folder and the cycle reports. A chained solver also saves where it is in its chain
+        (a digest of the chain's geometry, the cycles served and run, the chain's first
+        cycle): on resume the chain's job is run again and serves the next cycle, as the
+        uninterrupted run would (ccx's earlier steps do not depend on later ones). The
+        surfaces are set by their owner."""
+        chain = None
+        if self.mode == "chained" and self._job_key is not None and self.results is not None:
+            chain = [_digest(self._job_key), self._pos, self._job_cycles, self._chain_start]
         return {"cycle": self._cycle, "loaded": self._loaded, "mode": self.mode,
+                "material": self.material, "chain": chain,
+                "chain_restarts": self.chain_restarts,
+                "cycle_reports": list(self.cycle_reports),
                 "workdir": None if self.workdir is None else str(self.workdir)}
 
     def load_state_dict(self, state: dict[str, Any]) -> None:
         """Restore :meth:`state_dict` (the next cycle runs its own job)."""
         if state.get("mode", "fresh") != self.mode:
             raise ValueError(f"saved fe mode {state.get('mode')!r}, this solver {self.mode!r}")
+        if state.get("material", "elastic") != self.material:
+            raise ValueError(f"saved fe material {state.get('material')!r}, this solver "
+                             f"{self.material!r}")
         self._cycle = int(state["cycle"])
         self._loaded = bool(state["loaded"])
         self._k = None
         self._job_key = None
+        self.results = None
         self._served = []
+        self._pending = []
+        chain = state.get("chain")
+        self._resume_chain = None if chain is None else (
+            str(chain[0]), int(chain[1]), int(chain[2]), int(chain[3]))
+        self.chain_restarts = int(state.get("chain_restarts", 0))
+        self.cycle_reports = list(state.get("cycle_reports", []))
         if self.workdir is None and state.get("workdir"):
             self.workdir = Path(state["workdir"])
 

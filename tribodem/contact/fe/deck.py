@@ -58,12 +58,22 @@ class FEMaterial:
     yield_strength: float | None = None  #: Pa
     uts: float = 1000e6  #: Pa
     uts_strain: float = UTS_STRAIN_EN24T  #: total strain at the UTS, -
+    #: plastic modulus h = d sigma / d eps_p, Pa (None: the bilinear law through the UTS)
+    hardening: float | None = None
 
     def plastic_table(self) -> list[tuple[float, float]]:
-        """``*PLASTIC`` rows (true stress Pa, equivalent plastic strain) of the bilinear law."""
+        """``*PLASTIC`` rows (true stress Pa, equivalent plastic strain): the bilinear law
+        through (Y, 0) and (UTS, uts_strain - UTS / E), or, with ``hardening`` h, the line
+        sigma = Y + h eps_p (rows at eps_p = 0 and 1)."""
         if self.yield_strength is None:
             return []
         y, u = float(self.yield_strength), float(self.uts)
+        if self.hardening is not None:
+            h = float(self.hardening)
+            if not (y > 0 and h >= 0 and math.isfinite(h)):
+                raise ValueError(f"linear hardening needs Y > 0 and h >= 0; got Y={y!r}, "
+                                 f"h={h!r}")
+            return [(y, 0.0), (y + h, 1.0)]
         if not (0 < y < u) or self.uts_strain <= u / self.young:
             raise ValueError(f"bilinear hardening needs 0 < yield < uts and uts_strain > "
                              f"uts / E; got Y={y!r}, UTS={u!r}, uts_strain={self.uts_strain!r}")
@@ -123,6 +133,9 @@ class LoadCase:
     #: plastic strain and residual stress carry over; the first piece of ``chained`` mode);
     #: cycle k ends at total time 2 + 4 k
     cycles: int = 1
+    #: with ``split_cycle``: after the last cycle, lift the pad off under displacement
+    #: control (one more step of unit time: the residual, unloaded surfaces: pile-up, dent)
+    unload: bool = False
 
 
 def _fmt(v: float) -> str:
@@ -206,6 +219,8 @@ def _outputs(out: io.StringIO, plastic: bool, fine_stress: bool, frd: bool,
     tp = f", TIME POINTS={time_points}" if time_points else ""
     for name in stress_sets:
         out.write(f"*EL PRINT, ELSET={name}{tp}\nS\n")
+        if plastic:
+            out.write(f"*EL PRINT, ELSET={name}{tp}\nPEEQ\n")
     out.write(f"*NODE PRINT, NSET=LBOT, TOTALS=ONLY{tp}\nRF\n")
     out.write(f"*NODE PRINT, NSET=REF{tp}\nU\n")
     out.write(f"*NODE PRINT, NSET=UBOT{tp}\nU\n*NODE PRINT, NSET=LTOP{tp}\nU\n")
@@ -227,7 +242,7 @@ def write_deck(path: str | Path, mesh: Mesh, case: LoadCase,
     ``fine_stress``: print the integration-point stresses (and PEEQ) of the fine zones to the
     ``.dat`` every increment; ``frd``: also write displacements and stresses to the ``.frd``
     (for ParaView via ccx2paraview); ``stress_sets``: element sets of ``mesh`` whose
-    integration-point stresses are printed too."""
+    integration-point stresses (and PEEQ when a body is plastic) are printed too."""
     lower = lower or FEMaterial()
     upper = upper or FEMaterial()
     contact = contact or ContactSettings()
@@ -283,6 +298,14 @@ def write_deck(path: str | Path, mesh: Mesh, case: LoadCase,
                 _change_friction(out, mesh, lower, upper, contact, loading=False)
             out.write(f"*BOUNDARY\n{ref}, 1, 1, {_fmt(target)}\n" + controls)
             _outputs(out, plastic, fine_stress, frd, "TQUARTER", stress_sets)
+            out.write("*END STEP\n")
+        if case.unload:  # REF to a height where the surfaces have separated, load removed
+            lift = 2.0 * a * a / radius
+            dt = 1.0 / (n_load * refine)
+            out.write(f"*STEP, INC=1000\n*STATIC\n{dt}, 1., {dt * 1e-4}, {dt}\n")
+            out.write(f"*BOUNDARY, OP=NEW\nLBOT, 1, 2\n{ref}, 1, 1, 0.\n"
+                      f"{ref}, 2, 2, {_fmt(lift)}\n*CLOAD, OP=NEW\n{ref}, 2, 0.\n")
+            _outputs(out, plastic, fine_stress, frd, "TLOAD", stress_sets)
             out.write("*END STEP\n")
     elif case.delta > 0:
         dt = 4.0 / (n * refine)
