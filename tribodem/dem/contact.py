@@ -451,3 +451,138 @@ def pair_forces_sum(pos, vel, omega, radius, mass, inertia, mat, pair_i, pair_j,
         torque[j, 0] += b0
         torque[j, 1] += b1
         torque[j, 2] += b2
+
+
+@njit(cache=True, inline="always")
+def response_2d(law, prop, n0, n1, delta, v0, v1, w2, rstar, mstar, istar, lin_k, h0, h1,
+                dt):
+    """``response`` in the plane (disks): the same operations without the terms that are
+    exactly zero there (z of the normal, velocity and shear spring; x, y of the relative
+    spin ``w2`` = omega_1 - omega_2 about z). Returns (force on body 2 (x, y), rolling
+    torque on body 1 (z), normal force, energy, kn, shear spring (x, y)): the values
+    ``response`` gives for these inputs (only signs of zeros may differ)."""
+    vn = v0 * n0 + v1 * n1
+    fn, kt, ct, kn, energy = law_normal(law, prop, delta, vn, rstar, mstar, lin_k)
+    hn = h0 * n0 + h1 * n1
+    if hn != 0.0:
+        len0 = h0 * h0 + h1 * h1
+        h0 -= hn * n0
+        h1 -= hn * n1
+        len1 = h0 * h0 + h1 * h1
+        if len1 > 0.0:
+            sc = np.sqrt(len0 / len1)
+            h0 *= sc
+            h1 *= sc
+    vt0 = v0 - vn * n0
+    vt1 = v1 - vn * n1
+    h0 += vt0 * dt
+    h1 += vt1 * dt
+    ft0 = -kt * h0 - ct * vt0
+    ft1 = -kt * h1 - ct * vt1
+    ftm2 = ft0 * ft0 + ft1 * ft1
+    fmax = prop[P_MU] * (fn if fn > 0.0 else 0.0)
+    if ftm2 > fmax * fmax:
+        sc = fmax / np.sqrt(ftm2)
+        ft0 *= sc
+        ft1 *= sc
+        if kt > 0.0:
+            h0 = -(ft0 + ct * vt0) / kt
+            h1 = -(ft1 + ct * vt1) / kt
+        else:
+            h0 = 0.0
+            h1 = 0.0
+    energy += 0.5 * kt * (h0 * h0 + h1 * h1)
+    r2 = 0.0
+    mur = prop[P_MUR]
+    if mur > 0.0 and fn > 0.0:
+        wm = np.sqrt(w2 * w2)
+        if wm > 0.0:
+            tq = mur * fn * rstar
+            tlim = istar * wm / dt
+            if tq > tlim:
+                tq = tlim
+            r2 = -tq * w2 / wm
+    return fn * n0 + ft0, fn * n1 + ft1, r2, fn, energy, kn, h0, h1
+
+
+@njit(cache=True, inline="always")
+def _pair_2d(d0, d1, dist, ri, rj, vi0, vi1, vj0, vj1, wi2, wj2, mi, mj, ii, ij, prop, lin_k,
+             h0, h1, dt):
+    """``_pair`` for two disks in the plane (see ``response_2d``). Returns (force on j
+    (x, y), torque on i (z), torque on j (z), overlap, normal force, energy, kn, shear
+    spring (x, y))."""
+    delta = ri + rj - dist
+    inv = 1.0 / dist
+    n0 = d0 * inv
+    n1 = d1 * inv
+    ai = ri - 0.5 * delta
+    aj = rj - 0.5 * delta
+    v0 = (vj0 + aj * (wj2 * n1)) - (vi0 - ai * (wi2 * n1))
+    v1 = (vj1 - aj * (wj2 * n0)) - (vi1 + ai * (wi2 * n0))
+    rstar = ri * rj / (ri + rj)
+    mstar = mi * mj / (mi + mj)
+    istar = ii * ij / (ii + ij) if prop[P_MUR] > 0.0 else 0.0  # rolling friction only
+    law = int(prop[P_LAW])
+    f0, f1, r2, fn, energy, kn, h0, h1 = response_2d(
+        law, prop, n0, n1, delta, v0, v1, wi2 - wj2, rstar, mstar, istar, lin_k, h0, h1, dt)
+    tz = n0 * f1 - n1 * f0
+    return f0, f1, -ai * tz + r2, -aj * tz - r2, delta, fn, energy, kn, h0, h1
+
+
+@kernel
+def pair_forces_sum_2d(pos, vel, omega, radius, mass, inertia, mat, pair_i, pair_j, hist,
+                       pairtab, elin, length, periodic, dim, thickness, dt, fpair, tpair_i,
+                       tpair_j, pinfo, force, torque):
+    """``pair_forces_sum`` for disks (dim 2, ``FIX_2D``): the same operations without the
+    terms that are exactly zero in the plane (``_pair_2d``), so the same values (only
+    signs of zeros may differ) in fewer instructions. Leaves the z of ``force`` and
+    ``fpair``, the x and y of ``torque`` and the z of ``hist`` as they are (zero).
+    Serial build only."""
+    n = force.shape[0]
+    for i in range(n):
+        for k in range(3):
+            force[i, k] = 0.0
+            torque[i, k] = 0.0
+    m = pair_i.shape[0]
+    for p in range(m):
+        i = pair_i[p]
+        j = pair_j[p]
+        d0 = min_image(pos[j, 0] - pos[i, 0], length[0], periodic[0])
+        d1 = min_image(pos[j, 1] - pos[i, 1], length[1], periodic[1])
+        ri = radius[i]
+        rj = radius[j]
+        dist2 = d0 * d0 + d1 * d1
+        dist = np.sqrt(dist2)
+        delta = ri + rj - dist
+        if not (delta > 0.0 and dist2 > 0.0):  # apart: clear a contact that just ended
+            if pinfo[p, 0] > 0.0:
+                for k in range(3):
+                    hist[p, k] = 0.0
+                    fpair[p, k] = 0.0
+                    tpair_i[p, k] = 0.0
+                    tpair_j[p, k] = 0.0
+                pinfo[p, 1] = 0.0
+                pinfo[p, 2] = 0.0
+                pinfo[p, 3] = 0.0
+            pinfo[p, 0] = delta
+            continue
+        prop = pairtab[mat[i], mat[j]]
+        f0, f1, a2, b2, delta, fn, energy, kn, h0, h1 = _pair_2d(
+            d0, d1, dist, ri, rj, vel[i, 0], vel[i, 1], vel[j, 0], vel[j, 1], omega[i, 2],
+            omega[j, 2], mass[i], mass[j], inertia[i], inertia[j], prop,
+            _lin_k(prop, ri, rj, elin[mat[i]], elin[mat[j]], dim, thickness), hist[p, 0],
+            hist[p, 1], dt)
+        hist[p, 0] = h0
+        hist[p, 1] = h1
+        fpair[p, 0] = f0
+        fpair[p, 1] = f1
+        pinfo[p, 0] = delta
+        pinfo[p, 1] = fn
+        pinfo[p, 2] = energy
+        pinfo[p, 3] = kn
+        force[i, 0] -= f0
+        force[i, 1] -= f1
+        torque[i, 2] += a2
+        force[j, 0] += f0
+        force[j, 1] += f1
+        torque[j, 2] += b2

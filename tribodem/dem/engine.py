@@ -16,7 +16,14 @@ import numba
 import numpy as np
 
 from tribodem.dem import laws, neighbors
-from tribodem.dem.contact import HIST, Material, pair_forces, pair_forces_sum, pair_table
+from tribodem.dem.contact import (
+    HIST,
+    Material,
+    pair_forces,
+    pair_forces_sum,
+    pair_forces_sum_2d,
+    pair_table,
+)
 from tribodem.dem.errors import SimulationUnstable, TimeStepError
 from tribodem.dem.integrate import BLOCK, advance, critical_step
 from tribodem.dem.jit import serial_run
@@ -268,8 +275,9 @@ class Simulation:
 
     def _pair_forces(self) -> None:
         """Contacts of the listed pairs. On one thread (or a short list) the serial kernel
-        also sums them into ``force``/``torque`` (Newton pairs, no gather pass); threaded,
-        each pair is stored and ``advance`` gathers them in the same order."""
+        also sums them into ``force``/``torque`` (Newton pairs, no gather pass; disks: its
+        planar build ``pair_forces_sum_2d``); threaded, each pair is stored and ``advance``
+        gathers them in the same order."""
         p = self.p
         args = (p.pos, p.vel, p.omega, p.radius, p.mass, p.inertia, p.mat, self.nl.pair_i,
                 self.nl.pair_j, self.hist, self.pairtab, self.elin, self.box.length,
@@ -277,7 +285,8 @@ class Simulation:
                 self.tpair_j, self.pinfo)
         self._summed = serial_run(self.nl.n_pairs, self._threads)
         if self._summed:
-            laws.active(pair_forces_sum).serial(*args, self.force, self.torque)
+            fn = pair_forces_sum_2d if p.dim == 2 else pair_forces_sum
+            laws.active(fn).serial(*args, self.force, self.torque)
         else:
             laws.active(pair_forces).pick(self.nl.n_pairs, self._threads)(*args)
         self._evaluated = True
