@@ -4,7 +4,9 @@ One contract, :class:`FirstBodySolver` with its :class:`Capabilities`, driven th
 fretting cycles by :class:`tribodem.fretting.FrettingLoop`. Backends, registered by name in
 :data:`BACKENDS` (a new backend is one module here plus one line there):
 ``elastic`` :class:`HalfSpaceSolver` (elastic half-space BEM on tamaas) and
-``elastic-plastic`` :class:`ElastoPlasticSolver` (tamaas EPIC, bilinear EN24T).
+``elastic-plastic`` :class:`ElastoPlasticSolver` (tamaas EPIC, bilinear EN24T), ``fe``
+:class:`FEContactSolver` (CalculiX, plane strain) and ``fe3d`` :class:`FE3DContactSolver`
+(CalculiX, 3D crossed cylinders).
 """
 
 from tribodem.contact.base import (
@@ -30,6 +32,7 @@ from tribodem.contact.elastoplastic import (
     bilinear_hardening,
 )
 from tribodem.contact.fe.backend import FEContactSolver
+from tribodem.contact.fe.backend3d import FE3DContactSolver
 from tribodem.contact.geometry import (
     HeightMap,
     HertzSphere,
@@ -44,6 +47,7 @@ BACKENDS: dict[str, type[FirstBodySolver]] = {
     "elastic": HalfSpaceSolver,
     "elastic-plastic": ElastoPlasticSolver,
     "fe": FEContactSolver,
+    "fe3d": FE3DContactSolver,
 }
 
 __all__ = [
@@ -53,6 +57,7 @@ __all__ = [
     "Capabilities",
     "ElasticBody",
     "ElastoPlasticSolver",
+    "FE3DContactSolver",
     "FEContactSolver",
     "FirstBodySolver",
     "HalfSpaceSolver",

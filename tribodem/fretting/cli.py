@@ -671,8 +671,12 @@ def build_solver(cfg: FrettingConfig) -> FirstBodySolver:
         kw |= cfg.plastic.model_dump()
     if "line" in backend.capabilities.contacts and not isinstance(geo, HeightMaps):
         kw["contact"] = geo.contact
-    if backend is FEContactSolver:
+    if backend in (FEContactSolver, BACKENDS["fe3d"]):
         fe = cfg.fe.model_dump()
+        if backend is not FEContactSolver:  # fe3d: the [fe] mesh fields at their 2D
+            # defaults (h = a/4, bodies 40 a) do not fit the 3D model: its own apply
+            fe = {k: v for k, v in fe.items() if k not in ("h_over_a", "size_factor")
+                  or v != type(cfg.fe).model_fields[k].default}
         fe["threads"] = runs.check_threads(fe["threads"], "fe.threads (--threads)")
         kw |= fe | {"amplitude": c.amplitude, "n_increments": c.n_increments,
                     "stress_depth": cfg.wear.stress_depth}
@@ -810,7 +814,7 @@ def run_fretting(cfg: FrettingConfig, out: Path, echo: Any = None, resume: bool 
         meta, state = checkpoint if checkpoint is not None else read_checkpoint(ck)
         check_resume(cfg, meta, ck)
     loop = build_loop(cfg)
-    if isinstance(loop.solver, FEContactSolver):  # ccx decks, logs and results kept here
+    if isinstance(loop.solver, (FEContactSolver, BACKENDS["fe3d"])):  # ccx decks, logs, results
         loop.solver.workdir = out / "fe"
     if state is not None:
         try:
@@ -872,7 +876,8 @@ def run_fretting(cfg: FrettingConfig, out: Path, echo: Any = None, resume: bool 
     }
     summary = write_results(hist, out, extra)
     if hist.stopped:
-        fe_stop = isinstance(loop.solver, FEContactSolver) and "window" not in hist.stopped
+        fe_stop = isinstance(loop.solver, (FEContactSolver, BACKENDS["fe3d"])) and \
+            "window" not in hist.stopped
         runs.announce(out, ck, resume_hint="see the deck and its .log, then add --resume to "
                       "retry the cycle" if fe_stop else "a resume would stop at the same cycle:"
                       " to go on, start a new run with a larger contact.window")

@@ -44,7 +44,7 @@ import json
 import math
 import tempfile
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -65,7 +65,7 @@ from tribodem.contact.base import (
     contact_modulus,
     cycle_offsets,
 )
-from tribodem.contact.fe.backend import MODES, cell_average
+from tribodem.contact.fe.backend import cell_average
 from tribodem.contact.fe.ccx import (
     CcxConvergenceError,
     CcxRun,
@@ -102,6 +102,11 @@ FRETTING3D_H_OVER_A = 1.0 / 3.0
 FRETTING3D_SIZE_FACTOR = 8.0
 #: element growth outside the fine zone
 FRETTING3D_GROWTH = 1.4
+#: contact penalty of the 3D backend: normal stiffness = factor x E_min / h, Pa/m
+PENALTY_FACTOR = 10.0
+
+#: modes of :class:`FE3DContactSolver` (``chained`` is the 2D backend's only)
+MODES = ("fresh",)
 
 #: trilinear shape functions of the C3D8 nodes at its 2x2x2 Gauss points, [8 gp, 8 nodes];
 #: its inverse extrapolates Gauss-point values to the nodes
@@ -236,7 +241,9 @@ class FE3DContactSolver(FirstBodySolver):
     the threshold criteria's default grid depth 3 a); ``threads``, ``timeout`` (s per ccx
     job), ``retries`` (after a non-convergence each retry halves the largest increment);
     ``workdir``: the jobs' folder (``cycle_0001/`` ...; None: a new temporary folder).
-    ``regime`` and ``tolerance`` are the half-space's options and are not used.
+    ``regime`` and ``tolerance`` are the half-space's options and are not used, nor is
+    ``chain_cycles`` (mode ``chained`` of the 2D backend); ``material`` must be
+    ``"elastic"``.
     """
 
     capabilities = Capabilities(partial_slip=True, subsurface=True, contacts=("point",))
@@ -260,6 +267,8 @@ class FE3DContactSolver(FirstBodySolver):
         amplitude: float = 25e-6,
         n_increments: int = 8,
         mode: str = "fresh",
+        material: str = "elastic",
+        chain_cycles: int = 5,
         h_over_a: float = FRETTING3D_H_OVER_A,
         size_factor: float = FRETTING3D_SIZE_FACTOR,
         growth: float = FRETTING3D_GROWTH,
@@ -272,7 +281,7 @@ class FE3DContactSolver(FirstBodySolver):
         regime: str = "gross",
         tolerance: float | None = None,
     ) -> None:
-        del regime, tolerance  # half-space options (see the class docstring)
+        del regime, tolerance, chain_cycles  # not used (see the class docstring)
         if (upper is None) != (lower is None):
             raise ValueError("upper and lower must both be given or both be None (defaults)")
         if upper is None or lower is None:
@@ -281,7 +290,11 @@ class FE3DContactSolver(FirstBodySolver):
             raise ValueError(f"contact = {contact!r} is not allowed: the fe3d backend solves "
                              "crossed cylinders (a point contact); allowed: 'point'")
         if mode not in MODES:
-            raise ValueError(f"mode = {mode!r} is not allowed: allowed: {', '.join(MODES)}")
+            raise ValueError(f"mode = {mode!r} is not allowed for the fe3d backend: allowed: "
+                             f"{', '.join(MODES)}")
+        if material != "elastic":
+            raise ValueError(f"material = {material!r} is not allowed for the fe3d backend "
+                             "(elastic bodies only); allowed: 'elastic'")
         self.mode = mode
         self.executable = find_ccx(executable)
         self.upper, self.lower = upper, lower
@@ -332,8 +345,11 @@ class FE3DContactSolver(FirstBodySolver):
         self.workdir: Path | None = None if workdir is None else Path(workdir)
         self.stress_depth = (_check_positive("stress_depth", stress_depth)
                              if stress_depth is not None else 4.5 * a)
-        #: node-to-surface, pair declared once, n2s tension 1e-5 p0 (docs/fe.md "Reversals")
-        self.settings: ContactSettings = sliding_contact(self.friction, hz.peak_pressure)
+        #: node-to-surface, pair declared once, n2s tension 1e-5 p0 (docs/fe.md "Reversals"),
+        #: penalty 10 E / h (50 E / h, the 2D value, made the reversals' stick/slip states
+        #: flip for ever at h = a/2: measured, docs/fe3d.md), stick slope 0.1 x the penalty
+        self.settings: ContactSettings = replace(
+            sliding_contact(self.friction, hz.peak_pressure), penalty_factor=PENALTY_FACTOR)
         self.jobs: list[JobRecord3D] = []  #: every ccx job run, in order
         self._mesh0 = self._base_mesh()
         self._cols = mesh_columns(self._mesh0)
@@ -402,13 +418,24 @@ class FE3DContactSolver(FirstBodySolver):
         c = self.coords
         xe = mesh.nodes[mesh.elements, 0]
         ye = mesh.nodes[mesh.elements, 1]
-        near = (depth[mesh.elements].min(axis=1) < self.stress_depth) & (
-            ye.min(axis=1) <= c[-1])
+
+        def outer(grid: NDArray[np.float64], lo: float, hi: float) -> tuple[float, float]:
+            """The grid nodes enclosing [lo, hi] (the columns the interpolation uses)."""
+            i = max(int(np.searchsorted(grid, lo, side="right")) - 1, 0)
+            j = min(int(np.searchsorted(grid, hi, side="left")), grid.size - 1)
+            return float(grid[i]), float(grid[j])
+
         el = np.arange(1, mesh.elements.shape[0] + 1)
         lower = el <= mesh.n_lower
-        for name, body, lo, hi in (("LCOL", lower, c[0] - self.pad, c[-1] + self.pad),
-                                   ("UCOL", ~lower, c[0], c[-1])):
-            keep = body & near & (xe.min(axis=1) <= hi) & (xe.max(axis=1) >= lo)
+        for name, body, lo, hi in (("LCOL", "lower", c[0] - self.pad, c[-1] + self.pad),
+                                   ("UCOL", "upper", c[0], c[-1])):
+            xs, ys = _grid(mesh, body)
+            lo, hi = outer(xs, lo, hi)
+            y_hi = outer(ys, 0.0, c[-1])[1]
+            keep = ((lower if body == "lower" else ~lower)
+                    & (depth[mesh.elements].min(axis=1) < self.stress_depth)
+                    & (ye.min(axis=1) <= y_hi) & (xe.min(axis=1) <= hi)
+                    & (xe.max(axis=1) >= lo))
             mesh.element_sets[name] = el[keep]
         return mesh
 
@@ -702,6 +729,7 @@ class FE3DContactSolver(FirstBodySolver):
                 r = by[("displacements", name, tk)].rows
                 u[r[:, 0].astype(np.int64)] = r[:, 1:4]
             fn = np.where(self._complete[..., None], total[ubot], 0.0) / self._area[..., None]
+            fn[0, :, 1] = 0.0  # y = 0: the symmetry plane's reaction, no contact traction
             rf = by[("total force", "LBOT", tk)].rows[0, :3]
             states.append({"time": tk, "p": fn[..., 2], "qx": fn[..., 0], "qy": fn[..., 1],
                            "u_up": u[ubot + 1], "u_lo": u[ltop + 1],
@@ -916,6 +944,12 @@ class FE3DContactSolver(FirstBodySolver):
         keys = ("seconds_mesh", "seconds_ccx", "seconds_read", "seconds_map")
         return {"jobs": len(self.jobs),
                 **{k: float(np.mean([getattr(j, k) for j in self.jobs])) for k in keys}}
+
+    def report(self) -> dict[str, Any]:
+        """For summary.json: the mesh and the jobs' mean time profile (s)."""
+        return {"fe3d": {"elements": int(self._mesh0.elements.shape[0]),
+                         "h_fine_m": self._mesh0.h_fine, "size_factor": self.size_factor,
+                         "profile": self.profile()}}
 
     def write_json(self, path: str | Path) -> Path:
         """The jobs' records as JSON (for a run folder)."""
