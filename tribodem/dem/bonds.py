@@ -484,25 +484,27 @@ class ParallelBonds:
 
     def compute(self, sim: Simulation) -> None:
         """Update the bonds, break what exceeds its strength, add forces to ``ext_*``."""
-        if self.n_bonds == 0:
+        nb = self.i.size
+        if nb == 0:
             return
         p = sim.p
         threads = sim._threads
-        summed = serial_run(self.n_bonds, threads)
+        summed = serial_run(nb, threads)
+        length = sim.box_length
         if self.dim == 2:
-            nnew = bond_forces_2d.pick(self.n_bonds, threads)(
+            nnew = bond_forces_2d.pick(nb, threads)(
                 p.pos, p.vel, p.omega, p.radius, self.i, self.j, self.rb, self.area,
                 self.inertia, self.kn, self.ks, self.tensile, self.cohesion, self.tan_phi,
                 self.fn, self.fs, self.mb, self.normal, self.mode, self.newly, self.brk,
-                self.fbond, self.tbi, self.tbj, sim.dt, sim.box.length, sim.box.periodic,
+                self.fbond, self.tbi, self.tbj, sim.dt, length, sim.box.periodic,
                 summed, sim.ext_force, sim.ext_torque)
         else:
-            nnew = bond_forces.pick(self.n_bonds, threads)(
+            nnew = bond_forces.pick(nb, threads)(
                 p.pos, p.vel, p.omega, p.radius, self.i, self.j, self.rb, self.area,
                 self.inertia, self.polar, self.kn, self.ks, self.tensile, self.cohesion,
                 self.tan_phi, self.fn, self.fs, self.mb, self.mt, self.normal, self.mode,
                 self.newly, self.brk, self.fbond, self.tbi, self.tbj, self.dim, sim.dt,
-                sim.box.length, sim.box.periodic, summed, sim.ext_force, sim.ext_torque)
+                length, sim.box.periodic, summed, sim.ext_force, sim.ext_torque)
         if nnew:
             self._log_breaks(sim)
         if not summed:  # threaded: each bond stored, gathered per particle in bond order

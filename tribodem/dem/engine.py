@@ -119,6 +119,9 @@ class Simulation:
         self.hist = np.zeros((self.nl.n_pairs, HIST))
         self._threads: int | None = None  # numba threads, read once per step() call
         self._cross = np.zeros(0)  # cross_group_force's buffer
+        #: ``box.length`` as of the current ``step()`` call (read once per call by the
+        #: kernels and interactions; a box changed between calls is seen at the next)
+        self.box_length = self.box.length
         self._alloc_pairs()
         self.ext_force = np.zeros((n, 3))
         self.ext_torque = np.zeros((n, 3))
@@ -280,7 +283,7 @@ class Simulation:
         gathers them in the same order."""
         p = self.p
         args = (p.pos, p.vel, p.omega, p.radius, p.mass, p.inertia, p.mat, self.nl.pair_i,
-                self.nl.pair_j, self.hist, self.pairtab, self.elin, self.box.length,
+                self.nl.pair_j, self.hist, self.pairtab, self.elin, self.box_length,
                 self.box.periodic, p.dim, p.thickness, self.dt, self.fpair, self.tpair_i,
                 self.tpair_j, self.pinfo)
         self._summed = serial_run(self.nl.n_pairs, self._threads)
@@ -320,7 +323,7 @@ class Simulation:
             self._summed, self._wstart, self._wforce, self._wtorque, self.dt, self.gravity,
             self.viscous_damping, self.local_damping, bool(self.interactions), self.ext_force,
             self.ext_torque, self.force, self.torque, self.nl.ref_pos, self.nl.ref_radius,
-            self.box.lo, self.box.length, self.box.periodic, self.drift)
+            self.box.lo, self.box_length, self.box.periodic, self.drift)
 
     def step(self, n: int = 1) -> None:
         """Advance ``n`` steps. Raises ``SimulationUnstable`` (recorders flushed) on blow-up.
@@ -331,6 +334,7 @@ class Simulation:
         just measured).
         """
         self._threads = numba.get_num_threads()  # once per call: kernels pick builds by it
+        self.box_length = self.box.length  # once per call (the property makes an array)
         try:
             if self.step_count == 0 and self.time == 0.0:
                 self._sample(force=True)
