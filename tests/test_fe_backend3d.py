@@ -172,11 +172,15 @@ def test_gross_slip_and_signs(served) -> None:  # noqa: ANN001
         assert inc.normal_load == pytest.approx(LOAD, rel=1e-3)
         assert -inc.direction * q / (mu * inc.normal_load) == pytest.approx(1.0, abs=0.01)
         assert not inc.stick.any()
-    # the cycle dissipates less than the rigid-slip work 4 A mu P (the bodies' compliance
-    # takes part of each stroke: Mindlin's loop, 4 mu P (A - 0.8 delta*), delta* ~ 3.2 um)
+    # the cycle dissipates less than the rigid-slip work 4 A mu P: the bodies' compliance
+    # takes part of each stroke. Cattaneo-Mindlin (Johnson 7.41), delta* = 3 mu P / (16 a)
+    # sum (2 - nu) / G: from virgin bodies to gross slip 0.8 delta* of the stroke is not
+    # slid, at each of the two reversals 1.6 delta*: E = 4 mu P (A - delta*) for the fresh
+    # cycle 0 -> +A -> 0 -> -A -> 0; within 5 % (measured -1.6 % at A = 10 um, h = a/3)
     energy = sum(float(i.energy_density.sum()) * cell for i in incs)
-    rigid = 4 * AMPLITUDE * mu * LOAD
-    assert 0.5 * rigid < energy < rigid
+    poisson, shear = ElasticBody().poisson, ElasticBody().shear
+    delta_star = 3 * mu * LOAD / (16 * A) * 2 * (2 - poisson) / shear
+    assert energy == pytest.approx(4 * mu * LOAD * (AMPLITUDE - delta_star), rel=0.05)
 
 
 def test_subsurface_stress_on_the_axis(served) -> None:  # noqa: ANN001

@@ -786,12 +786,20 @@ class FE3DContactSolver(FirstBodySolver):
                 du_lo = (_bilinear(xl, ys_full, lo1, fx, fy)
                          - _bilinear(xl, ys_full, lo0, fx, fy)).reshape(up0.shape)
                 s_node = np.where(on[..., None], (up1 - up0) - du_lo, 0.0)
-                slip[..., 0] = np.where(contact, self._window(s_node[..., 0], 1.0, False), 0.0)
-                slip[..., 1] = np.where(contact, self._window(s_node[..., 1], -1.0, False),
-                                        0.0)
-                stick_node = on & (np.hypot(s_node[..., 0], s_node[..., 1])
-                                   <= self.friction * p_node / k_t)
-                stick = (self._window(stick_node.astype(float), 1.0, False) > 0.5) & contact
+                # interpolation weights renormalized over the contact nodes: the window's
+                # contact (cell averages of the bilinear pressure) reaches one node further
+                # than the FE contact, and a plain interpolation towards the zero slip of the
+                # free nodes there lost 4.6 % of the sliding distance (h = a/3, measured)
+                weight = self._window(on.astype(float), 1.0, False)
+                inside = contact & (weight > 0.0)
+                with np.errstate(invalid="ignore", divide="ignore"):
+                    for comp, sign in ((0, 1.0), (1, -1.0)):
+                        v = self._window(s_node[..., comp], sign, False) / weight
+                        slip[..., comp] = np.where(inside, v, 0.0)
+                    stick_node = on & (np.hypot(s_node[..., 0], s_node[..., 1])
+                                       <= self.friction * p_node / k_t)
+                    stick = inside & (self._window(stick_node.astype(float), 1.0, False)
+                                      / weight > 0.5)
                 off = float(self.offsets[j - 1])
                 start = float(self.offsets[j - 2]) if j >= 2 else 0.0
                 direction = math.copysign(1.0, off - start)
