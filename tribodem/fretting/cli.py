@@ -290,8 +290,15 @@ class OutputConfig(_Model):
 class FEConfig(_Model):
     """``solver = "fe"``: the CalculiX plane-strain backend (docs/fe.md)."""
 
-    mode: Literal["fresh"] = Field("fresh", description="fresh: one ccx job per cycle on the "
-                                   "worn geometry, virgin material (seed 003 section 3.3)")
+    mode: Literal["fresh", "chained"] = Field(
+        "fresh", description="fresh: one ccx job per cycle on the worn geometry, virgin "
+        "material (seed 003 section 3.3); chained: cycles continue in one job while the "
+        "geometry is unchanged, so plastic strain and residual stress carry over")
+    material: Literal["elastic", "elastic-plastic"] = Field(
+        "elastic", description="elastic-plastic: bilinear isotropic hardening of the "
+        "[plastic] table (seed table 5.1) in both bodies")
+    chain_cycles: int = Field(5, ge=1, le=1000, description="chained mode: cycles per ccx "
+                              "job (a used-up chain is run again with this many more)")
     h_over_a: float = Field(0.25, gt=0, le=1, description="element size at the contact / "
                             "Hertz half-width (docs/fe.md: a/4 is 4x faster than a/8 at "
                             "large strokes)")
@@ -624,7 +631,7 @@ def check_compatible(cfg: FrettingConfig) -> None:
     """Refuse, before any work, a criterion (or the debris third body) that needs what the
     chosen first-body backend cannot give, naming both and the backends that would do."""
     backend = BACKENDS[cfg.solver]
-    have = backend.capabilities.names()
+    have = backend.capabilities_for(cfg.fe.model_dump()).names()
     crit = CRITERIA[cfg.wear.criterion]
     needs = [(f"wear.criterion = {cfg.wear.criterion!r}", crit.requires)]
     if cfg.contact.geometry == "cylinder_on_flat":
@@ -646,12 +653,17 @@ def check_compatible(cfg: FrettingConfig) -> None:
     for who, req in needs:
         missing = set(req) - have
         if missing:
-            ok = [k for k, b in BACKENDS.items() if set(req) <= b.capabilities.names()]
+            ok = [k for k, b in BACKENDS.items() if set(req) <= b.capabilities.names()
+                  and k != cfg.solver]
+            opts = backend.options_for(set(missing))
+            allowed = [f"solver = {k!r}" for k in ok]
+            if opts and set(req) <= backend.capabilities.names():
+                allowed.insert(0, f"solver = {cfg.solver!r} with {opts}")
             raise ConfigError(
                 f"{who} needs {', '.join(CAPABILITY_TEXT.get(m, m) for m in sorted(missing))}, "
                 f"which solver = {cfg.solver!r} "
-                f"({backend.__name__}) does not give; allowed: solver = "
-                f"{' or '.join(repr(k) for k in ok) or '(none registered)'}")
+                f"({backend.__name__}) does not give as configured; allowed: "
+                f"{' or '.join(allowed) or '(no solver registered)'}")
 
 
 def build_solver(cfg: FrettingConfig) -> FirstBodySolver:
@@ -678,6 +690,12 @@ def build_solver(cfg: FrettingConfig) -> FirstBodySolver:
             fe = {k: v for k, v in fe.items() if k not in ("h_over_a", "size_factor")
                   or v != type(cfg.fe).model_fields[k].default}
         fe["threads"] = runs.check_threads(fe["threads"], "fe.threads (--threads)")
+        takes = inspect.signature(backend).parameters
+        for k in [k for k in fe if k not in takes]:  # an [fe] field this backend lacks
+            if fe[k] != type(cfg.fe).model_fields[k].default:
+                raise ConfigError(f"fe.{k} = {fe[k]!r}: solver = {cfg.solver!r} does not "
+                                  f"take it; allowed: leave fe.{k} out (solver = 'fe' has it)")
+            del fe[k]
         kw |= fe | {"amplitude": c.amplitude, "n_increments": c.n_increments,
                     "stress_depth": cfg.wear.stress_depth}
     try:
@@ -856,6 +874,8 @@ def run_fretting(cfg: FrettingConfig, out: Path, echo: Any = None, resume: bool 
         hist: FrettingHistory = loop.run(cfg.cycles, progress=report, checkpoint=save,
                                          checkpoint_every=cfg.output.checkpoint_every)
     files: list[str] = ["results.csv", "summary.json", "config.toml", CHECKPOINT]
+    if (out / "criterion.csv").exists():
+        files.append("criterion.csv")
     if cfg.output.figures:
         files += [p.name for p in write_figures(hist, out)]
     if cfg.output.vtk:
@@ -870,6 +890,7 @@ def run_fretting(cfg: FrettingConfig, out: Path, echo: Any = None, resume: bool 
                  **({"params": loop.strategy.params()} if loop.strategy else {})},
         "window_m": loop.solver.window,
         "contact_case": case_summary(cfg, loop.solver),
+        "first_body_report": loop.solver.report(),
         "wall_time_total_s": time.perf_counter() - t0,
         "files": files,
         "config": resolved,
@@ -973,6 +994,44 @@ def parse_counts(text: str, field: str = "--counts") -> tuple[int, ...]:
         raise ConfigError(f"{field} = {text!r}: allowed: comma-separated distinct particle "
                           "counts, each 1..10000000 (e.g. 22000,81000,102000)")
     return counts
+
+
+@fretting_app.command("study")
+def study_cmd(
+    out: Annotated[Path, typer.Option("--out", help="Output directory.")],
+    config: Annotated[Path | None, typer.Option(
+        "--config", help="TOML config of the case (default: the seed's crossed cylinders; "
+        "its criterion, cycles and jumping are the study's).")] = None,
+    solver: Annotated[str | None, typer.Option(
+        "--solver", help=f"First-body backend: {', '.join(BACKENDS)}.")] = None,
+    quick: Annotated[bool, typer.Option(
+        "--quick", help="64^2 grid, 5 and 15 cycles instead of 30 and 110.")] = False,
+    threads: Annotated[int | None, typer.Option(
+        "--threads", help="ccx threads of solver = 'fe' (0 = all cores).")] = None,
+    resume: Annotated[bool, typer.Option(
+        "--resume", help="Keep the finished stages of an earlier study in --out, resume the "
+        "unfinished one (its config unless given).")] = False,
+    progress: Annotated[bool, typer.Option(
+        "--progress/--no-progress", help="Progress bars of the runs on stderr.")] = True,
+) -> None:
+    """Seed 003 chapter 6: every material evolution criterion on one case (one cycle for
+    von Mises, S22, DFDI, SWT; 30 for shear and energy; shear with jumping to 110), the
+    seed's numbers beside ours and the criteria ordered (study.md, study.json)."""
+    from tribodem.fretting.study import run_study
+
+    runs.check_out_dir(out, "--out", resume=resume, need=("study.toml",) if resume else ())
+    ov: dict[str, Any] = {}
+    if solver is not None:
+        ov["solver"] = solver
+    if threads is not None:
+        ov.setdefault("fe", {})["threads"] = threads
+    base = load_toml(out / "study.toml", "--out")["config"] if resume and config is None \
+        else None
+    cfg = resolve_config(config, quick=quick, overrides=ov, base=base)
+    summary = run_study(cfg, out, quick=quick, resume=resume, progress=progress,
+                        echo=typer.echo)
+    typer.echo(f"done: criteria study ({summary['solver']}), ours largest first: "
+               f"{', '.join(summary['ranking_ours'])} -> {out}")
 
 
 @fretting_app.command("debris-study")

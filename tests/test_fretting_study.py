@@ -1,0 +1,82 @@
+"""``tribodem fretting study`` (seed 003 chapter 6) through the installed command, on a
+small grid with the elastic half-space."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from conftest import run_tribodem
+
+from tribodem.fretting.study import SEED, compare, ranking, stages
+
+CONFIG = """[contact]
+n = 32
+n_increments = 8
+[wear]
+stress_nz = 9
+stress_samples = 4
+swt_nz = 5
+swt_plane_step = 30.0
+[output]
+vtk = false
+"""
+
+
+def test_stages_are_the_seeds() -> None:
+    """One cycle for von Mises, S22, DFDI and SWT; 30 for shear and energy; shear with
+    jumping to 110 (--quick: 5 and 15)."""
+    full = {s.name: (s.criterion, s.cycles, s.jump) for s in stages()}
+    assert full == {"von_mises": ("von_mises", 1, "none"), "s22": ("s22", 1, "none"),
+                    "dfdi": ("dfdi", 1, "none"), "swt": ("swt", 1, "none"),
+                    "shear": ("shear", 30, "none"), "energy": ("energy", 30, "none"),
+                    "shear_jump": ("shear", 110, "adaptive")}
+    assert [s.cycles for s in stages(quick=True)][-3:] == [5, 5, 15]
+
+
+def test_compare_and_ranking() -> None:
+    """Ratios to the seed, the 20 % band, skipped stages as 'not run', the ordering by wear
+    per cycle with SWT (nothing worn) last."""
+    rows = [{"stage": "von_mises", "mean_scar_depth_lower_m": 0.1066e-3 * 1.1,
+             "mean_scar_depth_per_cycle_lower_m": 1.2e-4},
+            {"stage": "energy", "mean_scar_depth_per_cycle_lower_m": 1e-9},
+            {"stage": "swt", "mean_scar_depth_per_cycle_lower_m": 0.0,
+             "cycles_to_first_wear_lower": 700.0},
+            {"stage": "dfdi", "skipped": "no plastic strain"}]
+    t = {(r["stage"], r["quantity"]): r for r in compare(rows)}
+    assert abs(t[("von_mises", "mean_scar_depth_lower_m")]["ratio"] - 1.1) < 1e-12
+    assert t[("von_mises", "mean_scar_depth_lower_m")]["within_20pct"] is True
+    assert t[("dfdi", "mean_scar_depth_lower_m")]["ours"] is None
+    assert len(t) == sum(len(v) for v in SEED.values())
+    assert ranking(rows) == ["von_mises", "energy", "swt"]
+
+
+def test_study_command(tmp_path: Path) -> None:
+    """The quick study: every stage in its folder, DFDI skipped on the elastic half-space
+    with the reason, study.md/json with the seed's numbers; the shear run with jumping
+    outgrows the quick window, so the command exits 3 after writing the study (the seed's
+    own run stopped when the scar outgrew its fine mesh); --resume keeps the finished
+    stages (no stage runs again)."""
+    cfg = tmp_path / "c.toml"
+    cfg.write_text(CONFIG)
+    out = tmp_path / "study"
+    r = run_tribodem("fretting", "study", "--config", str(cfg), "--quick", "--out", str(out),
+                     "--no-progress")
+    assert r.returncode in (0, 3), r.stderr
+    s = json.loads((out / "study.json").read_text())
+    rows = {row["stage"]: row for row in s["rows"]}
+    assert "plastic" in rows["dfdi"]["skipped"]
+    for name in ("von_mises", "s22", "swt", "shear", "energy", "shear_jump"):
+        assert (out / name / "summary.json").is_file(), name
+    assert rows["von_mises"]["mean_scar_depth_lower_m"] > 0
+    assert rows["swt"]["cycles_to_first_wear_lower"] > 1
+    assert rows["energy"]["cycles"] == 5
+    assert (r.returncode == 3) == bool(rows["shear_jump"].get("stopped"))
+    md = (out / "study.md").read_text()
+    assert "0.000157" in md and "s22, von_mises, dfdi" in md  # seed numbers (m), order
+    mtimes = {p: p.stat().st_mtime_ns for p in out.glob("*/summary.json")}
+    r2 = run_tribodem("fretting", "study", "--out", str(out), "--quick", "--resume",
+                      "--no-progress")
+    assert r2.returncode == r.returncode, r2.stderr
+    finished = [p for p in mtimes if "shear_jump" not in str(p)]
+    assert all(p.stat().st_mtime_ns == mtimes[p] for p in finished)

@@ -1,0 +1,279 @@
+"""``tribodem fretting study``: seed 003 chapter 6 (the criteria study) as one command.
+
+Chapter 6 runs the seed's case (crossed 8 mm EN24T cylinders, 100 N, the 0.6 mm stroke) with
+each material evolution criterion and compares the wear it predicts: one cycle for the von
+Mises, vertical stress (S22), equivalent plastic strain (here DFDI, eqs 6.1-6.2) and SWT
+(eqs 6.3-6.8) criteria; 30 cycles for the shear (eq 6.9) and the energy criteria, and the
+shear criterion with cycle-jumping to 110 cycles (figs 6.14-6.16). Here every stage is one
+fretting run of the configured case and first-body backend (``--solver``) in its own folder
+``OUT/<stage>/`` (resumable, with its own outputs); ``study.json`` / ``study.md`` put every
+number beside the seed's and order the criteria by the wear they predict per cycle.
+
+Readings (stated in ``study.json``): "averaged wear depth over all nodes in the wear scar" is
+our ``wear_depth_mean_scar_*`` (the mean over the grid points with wear); the equivalent
+plastic strain criterion of section 6.5 is run as DFDI (the seed's threshold on the
+equivalent plastic strain with eq 6.2's failure strain); a stage whose criterion needs what
+the backend lacks (DFDI needs the ``plastic`` capability) is reported as skipped with the
+reason. The seed compares the predictions with an experiment whose data it gives only as
+figures, so the "closest to experiment" part of its ranking cannot be measured here: the
+study gives our ordering of the predicted wear per cycle beside the seed's ordering.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+#: The seed's numbers (chapter 6 text; depths in m, stresses in Pa).
+SEED = {
+    "von_mises": {"mean_scar_depth_lower_m": 0.1066e-3, "max_von_mises_Pa": 1600e6},
+    "s22": {"mean_scar_depth_lower_m": 0.157e-3, "mean_scar_depth_upper_m": 0.102e-3,
+            "max_s22_Pa": 1400e6},
+    "dfdi": {"mean_scar_depth_lower_m": 0.0456e-3, "mean_scar_depth_upper_m": 0.0463e-3},
+    "swt": {"cycles_to_first_wear_lower": 600, "cycles_to_first_wear_upper": 200_000},
+}
+#: The seed's conclusion (section 6.8): from the largest over-prediction to the largest
+#: under-prediction of the experiment; shear fits the experiment best.
+SEED_ORDER = ("s22", "von_mises", "dfdi", "shear", "energy", "swt")
+SEED_CONCLUSION = ("von Mises and S22 grossly over-predict, equivalent plastic strain still "
+                   "over-predicts, SWT under-predicts, the energy law under-predicts except "
+                   "near 1000 cycles, the shear criterion fits the experiment best")
+
+
+@dataclass(frozen=True)
+class Stage:
+    """One fretting run of the study."""
+
+    name: str  #: folder and key
+    criterion: str
+    cycles: int
+    jump: str = "none"  #: cycle-jumping strategy
+
+
+def stages(quick: bool = False) -> list[Stage]:
+    """The seed's stages (``quick``: 5 and 15 cycles instead of 30 and 110)."""
+    n30, n110 = (5, 15) if quick else (30, 110)
+    return [Stage("von_mises", "von_mises", 1), Stage("s22", "s22", 1),
+            Stage("dfdi", "dfdi", 1), Stage("swt", "swt", 1),
+            Stage("shear", "shear", n30), Stage("energy", "energy", n30),
+            Stage("shear_jump", "shear", n110, jump="adaptive")]
+
+
+def stage_config(cfg: Any, st: Stage) -> Any:
+    """The study's case with the stage's criterion, cycles and jumping."""
+    return cfg.model_copy(update={
+        "cycles": st.cycles,
+        "wear": cfg.wear.model_copy(update={"criterion": st.criterion}),
+        "jump": cfg.jump.model_copy(update={"strategy": st.jump, "params": {}}),
+        "debris": cfg.debris.model_copy(update={"every": None})})
+
+
+def row_of(st: Stage, summary: dict[str, Any]) -> dict[str, Any]:
+    """The study's numbers of one finished stage (from its summary.json)."""
+    crit = summary.get("criterion_last_cycle", {})
+    n = int(summary["cycles"])
+    row: dict[str, Any] = {
+        "stage": st.name, "criterion": st.criterion, "cycles": n, "jump": st.jump,
+        "cycles_simulated": summary["cycles_simulated"],
+        "mean_scar_depth_lower_m": summary["wear_depth_mean_scar_lower_m"],
+        "mean_scar_depth_upper_m": summary["wear_depth_mean_scar_upper_m"],
+        "max_depth_lower_m": summary["wear_depth_lower_m"],
+        "max_depth_upper_m": summary["wear_depth_upper_m"],
+        "worn_volume_lower_m3": summary["wear_volume_lower_m3"],
+        "wall_time_s": summary["wall_time_s"],
+    }
+    row["mean_scar_depth_per_cycle_lower_m"] = row["mean_scar_depth_lower_m"] / n
+    for body in ("upper", "lower"):
+        key = f"cycles_to_first_wear_{body}"
+        if key in crit:
+            row[key] = crit[key]
+    rep = summary.get("first_body_report", {}).get("cycles", [])
+    if rep:  # the backend's own peaks (fe: over the integration points of the cycle)
+        row["max_von_mises_Pa"] = max(c["max_von_mises_pa"] for c in rep)
+        row["max_s22_Pa"] = max(c["max_s22_compressive_pa"] for c in rep)
+    elif st.criterion in ("von_mises", "s22") and "max_value_lower" in crit:
+        # else the criterion's field maximum over the cycle (von Mises, |sigma_zz|; Pa)
+        key = "max_von_mises_Pa" if st.criterion == "von_mises" else "max_s22_Pa"
+        row[key] = max(crit["max_value_lower"], crit["max_value_upper"])
+    return row
+
+
+def compare(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """Every seed number beside ours: (stage, quantity, seed, ours, ours / seed)."""
+    out = []
+    by = {r["stage"]: r for r in rows}
+    for stage, nums in SEED.items():
+        r = by.get(stage)
+        for q, seed in nums.items():
+            ours = None if r is None or r.get("skipped") else r.get(q)
+            ratio = ours / seed if ours is not None and seed and math.isfinite(ours) else None
+            out.append({"stage": stage, "quantity": q, "seed": seed, "ours": ours,
+                        "ratio": ratio,
+                        "within_20pct": None if ratio is None else abs(ratio - 1) <= 0.2})
+    return out
+
+
+def ranking(rows: list[dict[str, Any]]) -> list[str]:
+    """Criteria ordered by the predicted mean scar depth per cycle on the lower body, largest
+    first (SWT by 1 / its projected cycles to first wear when nothing was worn yet)."""
+    def rate(r: dict[str, Any]) -> float:
+        v = float(r["mean_scar_depth_per_cycle_lower_m"])
+        if v == 0 and r.get("cycles_to_first_wear_lower"):
+            return -1.0 / float(r["cycles_to_first_wear_lower"])  # below every wearing one
+        return v
+    done = [r for r in rows if not r.get("skipped") and r["stage"] != "shear_jump"]
+    return [r["stage"] for r in sorted(done, key=rate, reverse=True)]
+
+
+def write_markdown(out: Path, rows: list[dict[str, Any]], table: list[dict[str, Any]],
+                   order: list[str], solver: str) -> Path:
+    """``study.md``: the stages, every seed number beside ours, the two orderings."""
+    from tribodem.io.results import write_text
+
+    um = 1e6
+    lines = [f"# Seed 003 chapter 6 criteria study (solver = {solver!r})", "",
+             "| stage | cycles (simulated) | mean scar depth lower / upper (um) | max depth "
+             "lower / upper (um) | per cycle, lower (um) | SWT cycles to first wear "
+             "lower / upper | wall s |", "|---|---|---|---|---|---|---|"]
+    for r in rows:
+        if r.get("skipped"):
+            lines.append(f"| {r['stage']} | skipped: {r['skipped']} | | | | | |")
+            continue
+        swt = (f"{r.get('cycles_to_first_wear_lower', float('nan')):.4g} / "
+               f"{r.get('cycles_to_first_wear_upper', float('nan')):.4g}"
+               if "cycles_to_first_wear_lower" in r else "")
+        stop = " stopped early" if r.get("stopped") else ""
+        lines.append(
+            f"| {r['stage']} | {r['cycles']} ({r['cycles_simulated']}){stop} | "
+            f"{r['mean_scar_depth_lower_m'] * um:.4g} / {r['mean_scar_depth_upper_m'] * um:.4g}"
+            f" | {r['max_depth_lower_m'] * um:.4g} / {r['max_depth_upper_m'] * um:.4g} | "
+            f"{r['mean_scar_depth_per_cycle_lower_m'] * um:.4g} | {swt} | "
+            f"{r['wall_time_s']:.1f} |")
+    lines += ["", "| stage | quantity | seed | ours | ours / seed | within 20 % |",
+              "|---|---|---|---|---|---|"]
+    for t in table:
+        ours = "not run" if t["ours"] is None else f"{t['ours']:.4g}"
+        ratio = "" if t["ratio"] is None else f"{t['ratio']:.3g}"
+        within = "" if t["within_20pct"] is None else ("yes" if t["within_20pct"] else "no")
+        lines.append(f"| {t['stage']} | {t['quantity']} | {t['seed']:.4g} | {ours} | {ratio} "
+                     f"| {within} |")
+    lines += ["", f"Ours, largest predicted wear per cycle first: {', '.join(order)}.",
+              f"Seed (section 6.8), largest over-prediction first: {', '.join(SEED_ORDER)}; "
+              f"{SEED_CONCLUSION}.", ""]
+    return write_text(out / "study.md", "\n".join(lines))
+
+
+def depth_plot(out: Path, runs_done: dict[str, Path]) -> Path | None:
+    """``depth_vs_cycles.png``: mean of the two bodies' max depths against the cycle for the
+    multi-cycle stages (figs 6.15-6.16)."""
+    import csv
+
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from tribodem.io.results import write_figure
+
+    multi = {k: p for k, p in runs_done.items() if k in ("shear", "energy", "shear_jump")}
+    if not multi:
+        return None
+    fig, ax = plt.subplots(figsize=(6, 4))
+    for name, folder in multi.items():
+        with open(folder / "results.csv") as fh:
+            rows = list(csv.DictReader(fh))
+        c = [int(r["cycle"]) for r in rows]
+        d = [float(r["wear_depth_lower_m"]) * 1e6 for r in rows]
+        ax.plot(c, d, "o-" if name != "shear_jump" else "--", ms=3, label=name)
+    ax.set_xlabel("cycle")
+    ax.set_ylabel("max wear depth, lower body (um)")
+    ax.legend()
+    fig.tight_layout()
+    return write_figure(out / "depth_vs_cycles.png", fig)
+
+
+def run_study(cfg: Any, out: Path, quick: bool = False, resume: bool = False,
+              progress: bool = False, echo: Any = None) -> dict[str, Any]:
+    """Every stage into ``out/<stage>/`` (a finished stage is kept on ``resume``, an
+    unfinished one resumes from its checkpoint); returns ``study.json``'s content."""
+    import json
+
+    from tribodem.fretting.cli import _jsonable, check_compatible, run_fretting
+    from tribodem.fretting.output import CHECKPOINT
+    from tribodem.io import runs
+    from tribodem.io.config import ConfigError, dump_toml, load_toml
+    from tribodem.io.results import write_json, write_text
+
+    say = echo or (lambda s: None)
+    out = Path(out)
+    runs.check_out_dir(out, "--out", resume=resume, need=("study.toml",) if resume else ())
+    plan = stages(quick)
+    meta = {"config": _jsonable(cfg), "quick": bool(quick)}
+    if resume:
+        from tribodem.fretting.debris_study import load_toml_roundtrip
+
+        if load_toml(out / "study.toml") != load_toml_roundtrip(meta):
+            raise ConfigError(f"--resume: the config differs from the study in '{out}'; "
+                              "allowed: the same config (and --quick) as the study")
+    out.mkdir(parents=True, exist_ok=True)
+    write_text(out / "study.toml", dump_toml(meta))
+    rows: list[dict[str, Any]] = []
+    done: dict[str, Path] = {}
+    stopped: dict[str, str] = {}
+    for k, st in enumerate(plan):
+        scfg = stage_config(cfg, st)
+        folder = out / st.name
+        try:
+            check_compatible(scfg)
+        except ConfigError as err:
+            rows.append({"stage": st.name, "criterion": st.criterion, "skipped": str(err)})
+            say(f"stage {k + 1}/{len(plan)} {st.name}: skipped ({err})")
+            continue
+        summary_path = folder / "summary.json"
+        finished = (resume and summary_path.is_file()
+                    and json.loads(summary_path.read_text()).get("cycles") == st.cycles)
+        if not finished:
+            jumping = f" with {st.jump} jumping" if st.jump != "none" else ""
+            say(f"stage {k + 1}/{len(plan)} {st.name}: criterion {st.criterion}, "
+                f"{st.cycles} cycle(s){jumping} -> {folder}")
+            try:
+                run_fretting(scfg, folder, echo=echo,
+                             resume=resume and (folder / CHECKPOINT).is_file(),
+                             progress=progress)
+            except runs.RunStopped as err:  # kept: the stage's outputs up to the stop
+                stopped[st.name] = str(err)
+                say(f"  {st.name} stopped early: {err}")
+            runs.announce(out, folder / CHECKPOINT, resume_hint="add --resume to the same "
+                          "command")
+        row = row_of(st, json.loads(summary_path.read_text()))
+        if st.name in stopped or row["cycles"] < st.cycles:
+            row["stopped"] = stopped.get(st.name, f"stopped at cycle {row['cycles']}")
+        rows.append(row)
+        done[st.name] = folder
+    table = compare(rows)
+    order = ranking(rows)
+    files = [write_markdown(out, rows, table, order, cfg.solver).name]
+    if cfg.output.figures:
+        p = depth_plot(out, done)
+        files += [p.name] if p else []
+    summary = {"solver": cfg.solver, "quick": bool(quick), "rows": rows, "seed_comparison": table,
+               "ranking_ours": order, "ranking_seed": list(SEED_ORDER),
+               "seed_conclusion": SEED_CONCLUSION,
+               "readings": {
+                   "mean_scar_depth": "the seed's 'averaged wear depth over all nodes in the "
+                   "wear scar' = mean over the grid points with wear (summary.json "
+                   "wear_depth_mean_scar_*)",
+                   "equivalent_plastic_strain": "run as DFDI (eqs 6.1-6.2)",
+                   "ranking": "ours: by mean scar depth per cycle on the lower body; the "
+                   "seed's: against an experiment given only as figures, not measurable here",
+               },
+               "files": [*files, "study.json", "study.toml"]}
+    write_json(out / "study.json", summary)
+    early = [r["stage"] for r in rows if r.get("stopped")]
+    if early:
+        raise runs.RunStopped(f"stage(s) {', '.join(early)} stopped early (see study.json "
+                              "'stopped'); study.md and study.json are written with the "
+                              "cycles they reached")
+    return summary
