@@ -80,3 +80,16 @@ def test_study_command(tmp_path: Path) -> None:
     assert r2.returncode == r.returncode, r2.stderr
     finished = [p for p in mtimes if "shear_jump" not in str(p)]
     assert all(p.stat().st_mtime_ns == mtimes[p] for p in finished)
+
+
+def test_select_stages() -> None:
+    """--stages picks stages by name, in the study's order; unknown names are refused
+    naming the allowed ones."""
+    import pytest
+
+    from tribodem.fretting.study import select
+
+    plan = stages()
+    assert [s.name for s in select(plan, ("swt", "s22"))] == ["s22", "swt"]
+    with pytest.raises(ValueError, match="allowed: .*von_mises,s22,dfdi"):
+        select(plan, ("shear", "wear"))

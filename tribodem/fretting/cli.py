@@ -1006,6 +1006,9 @@ def study_cmd(
         "--solver", help=f"First-body backend: {', '.join(BACKENDS)}.")] = None,
     quick: Annotated[bool, typer.Option(
         "--quick", help="64^2 grid, 5 and 15 cycles instead of 30 and 110.")] = False,
+    stages: Annotated[str | None, typer.Option(
+        "--stages", help="Comma-separated stages to run (default all: von_mises,s22,dfdi,"
+        "swt,shear,energy,shear_jump).")] = None,
     threads: Annotated[int | None, typer.Option(
         "--threads", help="ccx threads of solver = 'fe' (0 = all cores).")] = None,
     resume: Annotated[bool, typer.Option(
@@ -1028,8 +1031,9 @@ def study_cmd(
     base = load_toml(out / "study.toml", "--out")["config"] if resume and config is None \
         else None
     cfg = resolve_config(config, quick=quick, overrides=ov, base=base)
+    only = None if stages is None else tuple(x.strip() for x in stages.split(","))
     summary = run_study(cfg, out, quick=quick, resume=resume, progress=progress,
-                        echo=typer.echo)
+                        echo=typer.echo, only=only)
     typer.echo(f"done: criteria study ({summary['solver']}), ours largest first: "
                f"{', '.join(summary['ranking_ours'])} -> {out}")
 

@@ -194,10 +194,24 @@ def depth_plot(out: Path, runs_done: dict[str, Path]) -> Path | None:
     return write_figure(out / "depth_vs_cycles.png", fig)
 
 
+def select(plan: list[Stage], names: tuple[str, ...] | None) -> list[Stage]:
+    """The stages named (all when None); ``ValueError`` naming the allowed ones."""
+    if names is None:
+        return plan
+    known = [s.name for s in plan]
+    bad = [n for n in names if n not in known]
+    if bad or not names:
+        raise ValueError(f"--stages = {','.join(names)!r}: allowed: a comma-separated subset "
+                         f"of {','.join(known)}")
+    return [s for s in plan if s.name in names]
+
+
 def run_study(cfg: Any, out: Path, quick: bool = False, resume: bool = False,
-              progress: bool = False, echo: Any = None) -> dict[str, Any]:
-    """Every stage into ``out/<stage>/`` (a finished stage is kept on ``resume``, an
-    unfinished one resumes from its checkpoint); returns ``study.json``'s content."""
+              progress: bool = False, echo: Any = None,
+              only: tuple[str, ...] | None = None) -> dict[str, Any]:
+    """Every stage (``only``: those named) into ``out/<stage>/`` (a finished stage is kept
+    on ``resume``, an unfinished one resumes from its checkpoint); returns ``study.json``'s
+    content."""
     import json
 
     from tribodem.fretting.cli import _jsonable, check_compatible, run_fretting
@@ -209,7 +223,10 @@ def run_study(cfg: Any, out: Path, quick: bool = False, resume: bool = False,
     say = echo or (lambda s: None)
     out = Path(out)
     runs.check_out_dir(out, "--out", resume=resume, need=("study.toml",) if resume else ())
-    plan = stages(quick)
+    try:
+        plan = select(stages(quick), only)
+    except ValueError as err:
+        raise ConfigError(str(err)) from None
     meta = {"config": _jsonable(cfg), "quick": bool(quick)}
     if resume:
         from tribodem.fretting.debris_study import load_toml_roundtrip
