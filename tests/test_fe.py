@@ -221,13 +221,15 @@ def test_timeout_kills_ccx(tmp_path: Path) -> None:
 
 @needs_ccx
 def test_validate_fe_all_checks_pass(tmp_path: Path) -> None:
-    """The ``tribodem validate --solver fe`` checks at the default mesh (h = a / 8)."""
+    """The ``tribodem validate --solver fe`` 2D checks at the default mesh (h = a / 8), and
+    gross slip through the reversals of a cycle crossing elements (h = a / 2)."""
     from tribodem.contact.fe.validate import validate_fe
 
     checks = validate_fe(tmp_path, threads=1, timeout=600)
     names = [c["name"] for c in checks]
     for prefix in ("hertz_p0", "hertz_a", "first_yield_p0_over_vm", "gross_slip_Q_over_muP",
-                   "mindlin_c", "Q(delta", "slip_displacement", "plastic_onset_p0_over_Y"):
+                   "mindlin_c", "Q(delta", "slip_displacement", "plastic_onset_p0_over_Y",
+                   "reversal_gross_slip_Q_over_muP", "reversal_Q_sign_errors"):
         assert any(n.startswith(prefix) for n in names), prefix
     assert sum(n.startswith("mindlin_c") for n in names) == 3
     failed = [c for c in checks if not c["pass"]]

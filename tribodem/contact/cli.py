@@ -27,7 +27,8 @@ def validate(
     ] = True,
 ) -> None:
     """Closed-form checks of a first-body backend: Hertz (point, line), Cattaneo-Mindlin,
-    gross slip, first yield. Errors are relative, absolute (m) where the name says (m).
+    gross slip (fe: also through the reversals of a full cycle), first yield. Errors are
+    relative, absolute (m) where the name says (m).
     Exit 0 when every check passes, 3 otherwise."""
     from tribodem.io.runs import RunStopped
 
@@ -38,7 +39,10 @@ def validate(
             raise ConfigError("--solver = 'fe' needs CalculiX's ccx, which is not on PATH; "
                               "install it with: apt-get install -y calculix-ccx")
         from tribodem.contact.fe.validate import validate_fe
+        from tribodem.io.runs import announce
 
+        if keep is not None:  # Ctrl-C names the folder of the kept jobs
+            announce(keep, resume_hint="the checks start again from the beginning")
         with tempfile.TemporaryDirectory(prefix="tribodem_fe_") as tmp:
             checks = validate_fe(keep or tmp, threads=1)
             if three_d:

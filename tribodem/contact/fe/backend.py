@@ -626,7 +626,7 @@ class FEContactSolver(FirstBodySolver):
                                   f"{self.jobs[-1].deck if self.jobs else '?'})")
         return k
 
-    def _cycle_times(self, pos: int) -> NDArray[np.float64]:
+    def cycle_times(self, pos: int) -> NDArray[np.float64]:
         """Total times of the ends of cycle ``pos``'s increments (the job's cycle ``pos``,
         1-based, starts at 2 + 4 (pos - 1))."""
         return 2.0 + 4.0 * (pos - 1) + 4.0 * np.arange(1, self.n_increments + 1) \
@@ -735,7 +735,7 @@ class FEContactSolver(FirstBodySolver):
         t0 = time.perf_counter()
         if pos == 1:
             self._pend_loading()  # a job's first cycle comes with its loading
-        times = self._cycle_times(pos)
+        times = self.cycle_times(pos)
         prev = 2.0 + 4.0 * (pos - 1)
         out = []
         for j, t in enumerate(times):
@@ -930,8 +930,8 @@ class FEContactSolver(FirstBodySolver):
         (fretting cycle ``self._cycle + 1``, cycle ``pos`` of its job); see :meth:`report`."""
         assert self.results is not None
         res, mesh = self.results, self.mesh
-        t_end = float(self._cycle_times(pos)[-1])
-        times = [float(t) for t in self._cycle_times(pos)]
+        t_end = float(self.cycle_times(pos)[-1])
+        times = [float(t) for t in self.cycle_times(pos)]
         if pos == 1:
             times = [float(t) for t in self._loading_times()] + times
         row: dict[str, Any] = {"cycle": self._cycle + 1, "job_cycle": pos}

@@ -200,14 +200,49 @@ def default_case(h_over_a: float | None = None) -> LineCase:
     return dataclasses.replace(case, contact=sliding_contact(case.contact.mu, case.hertz[0]))
 
 
+def reversal_checks(folder: str | Path, threads: int = 1, timeout: float = 900.0
+                    ) -> list[dict[str, Any]]:
+    """Gross slip through the reversals of a full cycle whose stroke crosses elements
+    (docs/fe.md, "Reversals"): the ``fe`` backend's own job (node-to-surface, one step per
+    quarter) on the validation case at h = a/2, A = 2 a (4 elements), 16 increments
+    (every one slides 0.5 a, far past the ~3 um where gross slip is reached):
+    |Q| / (mu P) at every increment within 1 % of 1 (the worst one reported), and Q opposing
+    the pad's motion at every increment (count of wrong signs, 0 allowed)."""
+    from tribodem.contact.fe.backend import FEContactSolver
+
+    case = default_case()
+    p0, a = case.hertz
+    window = 10.0 * a
+    s = FEContactSolver(load=case.load * window, window=window, n=64, amplitude=2.0 * a,
+                        n_increments=16, h_over_a=0.5, threads=threads, timeout=timeout,
+                        workdir=Path(folder) / "reversal")
+    s.reset()
+    s.solve_increment(0.0)
+    s.begin_cycle()
+    res = s.results
+    assert res is not None
+    k = [res.at(float(t)) for t in s.cycle_times(1)]
+    q = res.tangential_force[k] / (case.contact.mu * res.normal_force[k])
+    direction = np.sign(np.diff(np.concatenate([[0.0], s.offsets])))
+    worst = int(np.argmax(np.abs(np.abs(q) - 1.0)))
+    wrong = int(np.sum(np.sign(q) != -direction))
+    return [check(f"reversal_gross_slip_Q_over_muP (worst of 16, increment {worst + 1})",
+                  float(abs(q[worst])), 1.0, 0.01),
+            check("reversal_Q_sign_errors", float(wrong), 0.0, 0.0, absolute=True)]
+
+
 def validate_fe(folder: str | Path, threads: int = 1, timeout: float = 900.0,
-                h_over_a: float | None = None, plastic: bool = True) -> list[dict[str, Any]]:
-    """Run :func:`default_case` (and :func:`plastic_onset_case`) in sub-folders ``elastic``
-    (and ``plastic``) of ``folder``; return every check."""
+                h_over_a: float | None = None, plastic: bool = True,
+                reversals: bool = True) -> list[dict[str, Any]]:
+    """Run :func:`default_case` (and :func:`plastic_onset_case`, :func:`reversal_checks`)
+    in sub-folders ``elastic`` (``plastic``, ``reversal``) of ``folder``; return every
+    check."""
     folder = Path(folder)
     run = run_line_case(default_case(h_over_a), folder / "elastic", threads=threads,
                         timeout=timeout)
     out = hertz_checks(run) + yield_checks(run) + tangential_checks(run)
+    if reversals:
+        out += reversal_checks(folder, threads=threads, timeout=timeout)
     if plastic:
         prun = run_line_case(plastic_onset_case(h_over_a), folder / "plastic", threads=threads,
                              timeout=timeout)
