@@ -72,3 +72,17 @@ def test_planar_kernels_give_the_general_values(law: str, bonded: bool,
         assert 0 < a.broken_count() == b.broken_count() < a.n_bonds
         for name in ("fn", "fs", "mb", "normal", "mode"):
             assert np.array_equal(getattr(a, name), getattr(b, name)), name
+
+
+def test_cross_group_force_equals_the_contacts_sum() -> None:
+    """``cross_group_force`` = the pushing contacts between groups, summed as numpy does."""
+    sim = packing("hertz", False)
+    sim.p.group[:] = (sim.p.pos[:, 0] > np.median(sim.p.pos[:, 0])).astype(np.int32)
+    for steps in (0, 50):
+        sim.step(steps)
+        c = sim.contacts()
+        g = sim.p.group
+        f = c["normal_force"]
+        want = float(f[(g[c["i"]] != g[c["j"]]) & (f > 0)].sum())
+        assert want > 0.0 or steps == 0  # before the first step: no forces yet
+        assert sim.cross_group_force() == want
