@@ -806,7 +806,9 @@ class FE3DContactSolver(FirstBodySolver):
             prev = st
             out.append(IncrementResult(
                 offset=off, start_offset=start, direction=direction, pressure=p,
-                traction=traction, slip=slip, contact_area=float(contact.sum()) * cell,
+                traction=traction, slip=slip,
+                contact_area=float((self._window(on.astype(float), 1.0, False) >= 0.5).sum())
+                * cell,
                 normal_load=float(p.sum()) * cell, stick=stick))
         self._loaded_result = out[0]
         self._served = out[1:]
