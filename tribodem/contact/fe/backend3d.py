@@ -44,7 +44,7 @@ import json
 import math
 import tempfile
 import time
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -348,8 +348,8 @@ class FE3DContactSolver(FirstBodySolver):
         #: node-to-surface, pair declared once, n2s tension 1e-5 p0 (docs/fe.md "Reversals"),
         #: penalty 10 E / h (50 E / h, the 2D value, made the reversals' stick/slip states
         #: flip for ever at h = a/2: measured, docs/fe3d.md), stick slope 0.1 x the penalty
-        self.settings: ContactSettings = replace(
-            sliding_contact(self.friction, hz.peak_pressure), penalty_factor=PENALTY_FACTOR)
+        self.settings: ContactSettings = sliding_contact(self.friction, hz.peak_pressure,
+                                                         penalty_factor=PENALTY_FACTOR)
         self.jobs: list[JobRecord3D] = []  #: every ccx job run, in order
         self._mesh0 = self._base_mesh()
         self._cols = mesh_columns(self._mesh0)
