@@ -551,10 +551,11 @@ class FEContactSolver(FirstBodySolver):
         refine = 1
         base = math.ceil(PLASTIC_MIN_INCREMENTS / self.n_increments) if self.plastic else 1
         for attempt in range(self.retries + 1):
-            refine = base * 2**attempt
+            refine = 2**attempt
             t1 = time.perf_counter()
             case = LoadCase(load=self.load_per_length, delta=self.amplitude,
                             n_increments=self.n_increments, seat=seat, refine=refine,
+                            cycle_refine=base,
                             split_cycle=True, cycles=int(cycles), unload=self.plastic,
                             load_increments=PLASTIC_LOAD_INCREMENTS if self.plastic else 5)
             name = "job" if attempt == 0 else f"job_refine{refine}"
@@ -577,7 +578,7 @@ class FEContactSolver(FirstBodySolver):
         res = read_results(run.job, mesh)
         t_read = time.perf_counter() - t3
         rec = JobRecord(cycle=self._cycle + 1, folder=folder, deck=run.job.with_suffix(".inp"),
-                        elements=mesh.n_elements, refine=refine, seconds_mesh=t_mesh,
+                        elements=mesh.n_elements, refine=refine * base, seconds_mesh=t_mesh,
                         seconds_ccx=t_ccx, seconds_read=t_read, cycles=int(cycles),
                         worn_area_upper=mesh_worn_area(self._mesh0, mesh, "upper"),
                         worn_area_lower=mesh_worn_area(self._mesh0, mesh, "lower"))

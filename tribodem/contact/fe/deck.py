@@ -133,6 +133,8 @@ class LoadCase:
     #: divide the largest automatic increment of the loading and the cycle by this factor,
     #: keeping the output times (the retry after a non-convergence)
     refine: int = 1
+    #: divide the largest automatic increment of the cycle only (on top of ``refine``)
+    cycle_refine: int = 1
     #: the cycle as one step per monotonic quarter (0 -> +d, +d -> 0, 0 -> -d, -d -> 0),
     #: ramped boundary values instead of the ``*AMPLITUDE``: ccx 2.20's surface-to-surface
     #: friction keeps a wrong tangential state through a reversal inside one step (docs/fe.md)
@@ -299,7 +301,7 @@ def write_deck(path: str | Path, mesh: Mesh, case: LoadCase,
             raise ValueError(f"cycles = {case.cycles!r} is not allowed: an integer >= 1")
         targets = ([case.delta, 0.0, -case.delta, 0.0] * int(case.cycles))[
             :1 if case.half_cycle else None]
-        dt = 4.0 / (n * refine)
+        dt = 4.0 / (n * refine * max(int(case.cycle_refine), 1))
         for k, target in enumerate(targets):
             out.write(f"*STEP, INC=10000\n*STATIC\n{dt}, 1., {dt * 1e-4}, {dt}\n")
             if k == 0:
