@@ -692,7 +692,12 @@ class FEContactSolver(FirstBodySolver):
             x_flat = xu0 + u_up0 - np.interp(xu0 + u_up0, xl0, u_lo0)
             du_lo = np.interp(x_flat, xl0, u_lo1) - np.interp(x_flat, xl0, u_lo0)
             s_node = np.where(p_node > 0.0, (u_up1 - u_up0) - du_lo, 0.0)
-            slip_x = np.where(contact_x, np.interp(c, xu0, s_node), 0.0)
+            # slip on the window from the contact nodes only: the window's contact reaches
+            # up to one node beyond the FE contact (the pressure's linear interpolant), and
+            # interpolating towards a free node's zero slip there lost sliding distance
+            on = p_node > 0.0
+            s_on = np.interp(c, xu0[on], s_node[on]) if on.any() else np.zeros(n)
+            slip_x = np.where(contact_x, s_on, 0.0)
             stick_node = (p_node > 0.0) & (np.abs(s_node) <= self.friction * p_node / k_t)
             stick = np.interp(c, xu0, stick_node.astype(float)) > 0.5
             stick = np.repeat((stick & contact_x)[:, None], n, axis=1)
