@@ -858,10 +858,12 @@ class FEContactSolver(FirstBodySolver):
         if depth is None:
             depth = 3.0 * max(result.contact_area, self.dx**2) / (2.0 * self.window)
         depth = _check_positive("depth", depth)
-        if depth > self.stress_depth * (1 + 1e-9):
-            raise ValueError(f"depth = {depth!r} m is not allowed: the fe solver prints the "
-                             f"column stresses down to {self.stress_depth:.4g} m "
-                             "(its stress_depth; wear.stress_depth of a fretting config)")
+        if depth > self.stress_depth * (1 + 1e-9):  # a run stops (exit 3), saying how
+            raise FESolverStopped(
+                f"the stress grid asked for reaches {depth:.4g} m below the surface, deeper "
+                f"than the fe solver prints the column stresses ({self.stress_depth:.4g} m); "
+                "set wear.stress_depth (it sets both the criterion's grid and the depth ccx "
+                "prints)")
         x = self.coords + (result.offset if body == "lower" else 0.0)
         z = np.linspace(0.0, depth, int(nz))
         voigt = self._voigt(self._column_field(body, self._nodal_stress(body, t), x, z), body)

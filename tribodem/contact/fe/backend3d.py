@@ -887,10 +887,12 @@ class FE3DContactSolver(FirstBodySolver):
         if depth is None:
             depth = 3.0 * math.sqrt(max(result.contact_area, self.dx**2) / math.pi)
         depth = _check_positive("depth", depth)
-        if depth > self.stress_depth * (1 + 1e-9):
-            raise ValueError(f"depth = {depth!r} m is not allowed: the fe3d solver prints the "
-                             f"column stresses down to {self.stress_depth:.4g} m (its "
-                             "stress_depth; wear.stress_depth of a fretting config)")
+        if depth > self.stress_depth * (1 + 1e-9):  # a run stops (exit 3), saying how
+            raise FESolverStopped(
+                f"the stress grid asked for reaches {depth:.4g} m below the surface, deeper "
+                f"than the fe3d solver prints the column stresses ({self.stress_depth:.4g} m); "
+                "set wear.stress_depth (it sets both the criterion's grid and the depth ccx "
+                "prints)")
         nodal = self._nodal_stress(body, t)
         cols = self._cols[body]  # [ny, nx, nl]
         zc = self.mesh.nodes[cols, 2]
