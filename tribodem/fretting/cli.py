@@ -299,6 +299,9 @@ class FEConfig(_Model):
         "[plastic] table (seed table 5.1) in both bodies")
     chain_cycles: int = Field(5, ge=1, le=1000, description="chained mode: cycles per ccx "
                               "job (a used-up chain is run again with this many more)")
+    plastic_increments: int = Field(32, ge=4, le=10000, description="elastic-plastic: the "
+                                    "fewest ccx increments per cycle (32 converged where 16 "
+                                    "stalled, docs/fe.md)")
     h_over_a: float = Field(0.25, gt=0, le=1, description="element size at the contact / "
                             "Hertz half-width (docs/fe.md: a/4 is 4x faster than a/8 at "
                             "large strokes)")

@@ -181,7 +181,8 @@ class FEContactSolver(FirstBodySolver):
     hardening, ``*PLASTIC``: ``yield_strength``, ``uts``, ``uts_strain`` (Pa, Pa, -) of seed
     table 5.1, or a plastic modulus ``hardening`` h in Pa; the tamaas EPIC grid options
     ``ep_*``, ``load_steps`` are accepted and not used: the mesh is the grid). Plastic jobs
-    take >= 32 cycle increments and 10 load increments (docs/fe.md).
+    take >= ``plastic_increments`` (32) ccx increments per cycle and 10 load increments
+    (docs/fe.md).
 
     ``mode``: ``"fresh"`` (every cycle one job on virgin bodies) or ``"chained"``: a job runs
     ``chain_cycles`` cycles on the same bodies, so plastic strain and residual stress carry
@@ -232,6 +233,7 @@ class FEContactSolver(FirstBodySolver):
         mode: str = "fresh",
         material: str = "elastic",
         chain_cycles: int = 5,
+        plastic_increments: int = PLASTIC_MIN_INCREMENTS,
         yield_strength: float = EN24T.yield_strength,
         uts: float = EN24T.uts,
         uts_strain: float = EN24T.uts_strain,
@@ -274,6 +276,10 @@ class FEContactSolver(FirstBodySolver):
         self.material = material
         self.plastic = material == "elastic-plastic"
         self.chain_cycles = int(chain_cycles)
+        if int(plastic_increments) != plastic_increments or plastic_increments < 4:
+            raise ValueError(f"plastic_increments = {plastic_increments!r} is not allowed: "
+                             "an integer >= 4")
+        self.plastic_increments = int(plastic_increments)
         self.capabilities = self.capabilities_for({"material": material, "mode": mode})
         self.plastic_law = FEMaterial(
             yield_strength=_check_positive("yield_strength", yield_strength),
@@ -549,7 +555,7 @@ class FEContactSolver(FirstBodySolver):
         t_ccx = 0.0
         run: CcxRun | None = None
         refine = 1
-        base = math.ceil(PLASTIC_MIN_INCREMENTS / self.n_increments) if self.plastic else 1
+        base = math.ceil(self.plastic_increments / self.n_increments) if self.plastic else 1
         for attempt in range(self.retries + 1):
             refine = 2**attempt
             t1 = time.perf_counter()
