@@ -259,3 +259,20 @@ def test_python_api_early_stop_raises_run_stopped(tmp_path: Path) -> None:
     with pytest.raises(RunStopped, match="window"):
         run_fretting(cfg, tmp_path / "run")
     assert json.loads((tmp_path / "run" / "summary.json").read_text())["stopped"]
+
+
+def test_resume_accepts_a_field_added_since_the_checkpoint_at_its_default_only() -> None:
+    """A checkpoint made before a config field existed lacks it: resuming is allowed while
+    the field keeps its default (the behaviour the checkpoint ran with), refused otherwise."""
+    from tribodem.fretting.cli import FrettingConfig, check_resume
+    from tribodem.io.config import ConfigError
+
+    cfg = FrettingConfig()
+    old = json.loads(json.dumps(cfg.model_dump()))
+    del old["fe"]["plastic_increments"]
+    meta = {"config": old, "cycles_done": 0}
+    check_resume(cfg, meta, Path("ck.npz"))  # the default: same behaviour
+    changed = FrettingConfig(fe={"plastic_increments": 16})
+    absent = r"fe\.plastic_increments = 16 \(checkpoint: '<absent>'\)"
+    with pytest.raises(ConfigError, match=absent):
+        check_resume(changed, meta, Path("ck.npz"))

@@ -800,9 +800,13 @@ def check_resume(cfg: FrettingConfig, meta: dict[str, Any], path: Path) -> None:
     old = _flat(meta.get("config") or {})
     new = _flat(_jsonable(cfg))
     absent = "<absent>"
+    # A field added to tribodem after the checkpoint was made is absent from it; at its
+    # default it keeps the behaviour the checkpoint ran with, so it is not a difference.
+    default = _flat(_jsonable(FrettingConfig()))
     diffs = [f"{k} = {new.get(k, absent)!r} (checkpoint: {old.get(k, absent)!r})"
              for k in sorted(set(old) | set(new))
-             if not k.startswith(RESUME_MAY_CHANGE) and old.get(k, absent) != new.get(k, absent)]
+             if not k.startswith(RESUME_MAY_CHANGE) and old.get(k, absent) != new.get(k, absent)
+             and not (k not in old and k in default and new.get(k) == default[k])]
     if diffs:
         raise ConfigError(
             f"--resume: the config differs from the one checkpoint '{path}' was made with: "
