@@ -40,13 +40,9 @@ slip ``|Q| = mu P`` (tests/test_fe_backend.py).
 
 from __future__ import annotations
 
-import csv
 import hashlib
-import json
 import math
-import tempfile
 import time
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -70,19 +66,16 @@ from tribodem.contact.base import (
 )
 from tribodem.contact.elastoplastic import PlasticStep
 from tribodem.contact.fe.ccx import (
-    CcxConvergenceError,
-    CcxRun,
     FESolverStopped,
     find_ccx,
-    run_ccx,
 )
 from tribodem.contact.fe.deck import FEMaterial, LoadCase, sliding_contact, write_deck
+from tribodem.contact.fe.jobs import CcxJobs, JobRecord, check_stress_depth, run_job
 from tribodem.contact.fe.mesh import Mesh, PadOnFlat, cylinder_on_flat, hertz_line, morph_columns
 from tribodem.contact.fe.mesh import worn_area as mesh_worn_area
 from tribodem.contact.fe.results import GAUSS_2X2, FEResults, ip_coordinates, read_results
 from tribodem.contact.geometry import cylinder, flat, line_window
 from tribodem.contact.halfspace import max_shear, von_mises
-from tribodem.io.results import write_csv
 from tribodem.materials.en24t import EN24T
 
 #: default element size at the contact / Hertz half-width of the backend: a/4 (p0 within
@@ -141,25 +134,7 @@ def cell_average(xn: NDArray[np.float64], vn: NDArray[np.float64],
     return (prim(centres + 0.5 * dx) - prim(centres - 0.5 * dx)) / dx
 
 
-@dataclass
-class JobRecord:
-    """One ccx job of the backend: where, what it cost (s) and what it gave."""
-
-    cycle: int  #: the fretting cycle it serves (1-based)
-    folder: Path
-    deck: Path
-    elements: int
-    refine: int  #: increment refinement of the successful attempt (1: none)
-    seconds_mesh: float  #: meshing, morphing and deck writing, s
-    seconds_ccx: float  #: ccx wall clock (all attempts), s
-    seconds_read: float  #: reading the .dat and recovering the tractions, s
-    seconds_map: float = 0.0  #: mapping the fields to the window, s
-    cycles: int = 1  #: cycles after the loading in the job (chained mode: > 1)
-    worn_area_upper: float = 0.0  #: worn area of the morphed pad, m^2 per m
-    worn_area_lower: float = 0.0  #: worn area of the morphed flat, m^2 per m
-
-
-class FEContactSolver(FirstBodySolver):
+class FEContactSolver(CcxJobs, FirstBodySolver):
     """Plane-strain CalculiX cylinder-on-flat first body (see the module docstring).
 
     ``upper``/``lower``: recessions (m) of a cylinder with its axis along y and of a flat
@@ -194,6 +169,7 @@ class FEContactSolver(FirstBodySolver):
 
     #: every capability some configuration gives; an instance's own are
     #: :meth:`capabilities_for` its ``material`` and ``mode``
+    name = "fe"
     capabilities = Capabilities(plastic=True, plastic_every_cycle=True, partial_slip=True,
                                 subsurface=True, contacts=("line",))
 
@@ -464,12 +440,6 @@ class FEContactSolver(FirstBodySolver):
         if self.mode == "chained":
             self._job_key = None
 
-    def begin_cycle(self) -> None:
-        """Make this cycle's increments: a new ccx job on the current surfaces, or (fresh
-        mode, first cycle) the loading's job, or (chained mode, same geometry) the next
-        cycle of the chain's job."""
-        self._start_cycle()
-
     def _start_cycle(self) -> None:
         key = self._key()
         same = key == self._job_key and self.results is not None
@@ -497,49 +467,15 @@ class FEContactSolver(FirstBodySolver):
         self._cycle += 1
         self._k = 0
 
-    def _key(self) -> tuple[bytes, bytes]:
-        wu, wl = self.column_wear()
-        return wu.tobytes(), wl.tobytes()
-
-    def solve_increment(self, offset: float) -> IncrementResult:
-        """Serve the stored increment ending at ``offset`` (m): ``0.0`` after :meth:`reset`
-        is the normal loading; then the cycle's offsets in order (:func:`cycle_offsets` of
-        ``amplitude``, ``n_increments``); anything else is a ``ValueError``."""
-        offset = float(offset)
-        if self._k is None:
-            if offset == 0.0 and not self._loaded:
-                key = self._key()
-                if key != self._job_key or self.results is None:
-                    self._run_job(self.chain_cycles if self.mode == "chained" else 1,
-                                  chain_start=self._cycle + 1)
-                self._fresh_for_cycle = True  # the first cycle may reuse this job
-                self._loaded = True
-                return self._serve_loading()
-            self._start_cycle()
-        assert self._k is not None
-        expected = float(self.offsets[self._k])
-        if abs(offset - expected) > 1e-9 * self.amplitude:
-            raise ValueError(
-                f"offset = {offset!r} m is not increment {self._k + 1} of the fe job's cycle "
-                f"(expected {expected!r} m: amplitude {self.amplitude:g} m, n_increments "
-                f"{self.n_increments}); the fe backend serves the cycle 0 -> +A -> 0 -> -A -> 0"
-                " in order")
-        inc = self._served[self._k]
-        self._k += 1
-        self._loaded = True
-        if self._k == len(self.offsets):
-            self._k = None
-        return inc
+    def _load(self) -> IncrementResult:
+        if self._key() != self._job_key or self.results is None:
+            self._run_job(self.chain_cycles if self.mode == "chained" else 1,
+                          chain_start=self._cycle + 1)
+        return self._serve_loading()
 
     # -- the job ---------------------------------------------------------------------------
-    _fresh_for_cycle = False
     results: FEResults | None = None  #: the parsed results of the last job
     _resume_chain: tuple[str, int, int, int] | None = None
-
-    def _folder(self) -> Path:
-        if self.workdir is None:
-            self.workdir = Path(tempfile.mkdtemp(prefix="tribodem-fe-"))
-        return self.workdir / f"cycle_{self._cycle + 1:04d}"
 
     def _run_job(self, cycles: int = 1, chain_start: int = 1) -> None:
         """Mesh, morph, write, run (retrying with smaller increments) and read one job of
@@ -552,42 +488,28 @@ class FEContactSolver(FirstBodySolver):
         lower, upper = self._materials()
         seat = self._seat(mesh)
         t_mesh = time.perf_counter() - t0
-        t_ccx = 0.0
-        run: CcxRun | None = None
-        refine = 1
         base = math.ceil(self.plastic_increments / self.n_increments) if self.plastic else 1
-        for attempt in range(self.retries + 1):
-            refine = 2**attempt
-            t1 = time.perf_counter()
+
+        def write(refine: int, name: str) -> Path:
             case = LoadCase(load=self.load_per_length, delta=self.amplitude,
                             n_increments=self.n_increments, seat=seat, refine=refine,
                             cycle_refine=base,
                             split_cycle=True, cycles=int(cycles), unload=self.plastic,
                             load_increments=PLASTIC_LOAD_INCREMENTS if self.plastic else 5)
-            name = "job" if attempt == 0 else f"job_refine{refine}"
-            deck = write_deck(folder / f"{name}.inp", mesh, case, lower, upper, self.settings,
+            return write_deck(folder / f"{name}.inp", mesh, case, lower, upper, self.settings,
                               fine_stress=False, stress_sets=("LCOL", "UCOL"))
-            t_mesh += time.perf_counter() - t1
-            t2 = time.perf_counter()
-            try:
-                run = run_ccx(deck, threads=self.threads, timeout=self.timeout,
-                              executable=self.executable)
-            except CcxConvergenceError:
-                t_ccx += time.perf_counter() - t2
-                if attempt == self.retries:
-                    raise
-                continue
-            t_ccx += time.perf_counter() - t2
-            break
-        assert run is not None
+
+        run, refine, t_deck, t_ccx = run_job(write, self.retries, self.threads, self.timeout,
+                                             self.executable)
+        t_mesh += t_deck
         t3 = time.perf_counter()
         res = read_results(run.job, mesh)
         t_read = time.perf_counter() - t3
         rec = JobRecord(cycle=self._cycle + 1, folder=folder, deck=run.job.with_suffix(".inp"),
                         elements=mesh.n_elements, refine=refine * base, seconds_mesh=t_mesh,
                         seconds_ccx=t_ccx, seconds_read=t_read, cycles=int(cycles),
-                        worn_area_upper=mesh_worn_area(self._mesh0, mesh, "upper"),
-                        worn_area_lower=mesh_worn_area(self._mesh0, mesh, "lower"))
+                        worn_volume_upper=self.worn_volume("upper", mesh),
+                        worn_volume_lower=self.worn_volume("lower", mesh))
         self.mesh = mesh
         self.results = res
         self._job_key = self._key()
@@ -600,30 +522,6 @@ class FEContactSolver(FirstBodySolver):
         self._time_of = {}  # total time of each increment served from this job
         self.jobs.append(rec)
         self._write_profile()
-
-    _prior_jobs: list[list[str]] | None = None
-    _JOB_COLUMNS = ("cycle", "cycles", "elements", "refine", "seconds_mesh", "seconds_ccx",
-                    "seconds_read", "seconds_map", "worn_volume_upper_m3",
-                    "worn_volume_lower_m3", "deck")
-
-    def _write_profile(self) -> None:
-        """``workdir/jobs.csv``: one row per job (with the rows of an earlier session of a
-        resumed run), rewritten atomically whenever a job is run or its fields are mapped."""
-        assert self.workdir is not None
-        path = self.workdir / "jobs.csv"
-        if self._prior_jobs is None:
-            self._prior_jobs = []
-            if path.exists():
-                with open(path, newline="") as fh:
-                    rows = list(csv.reader(fh))
-                if rows and tuple(rows[0]) == self._JOB_COLUMNS:
-                    self._prior_jobs = rows[1:]
-        rows = [[rec.cycle, rec.cycles, rec.elements, rec.refine, f"{rec.seconds_mesh:.4f}",
-                 f"{rec.seconds_ccx:.3f}", f"{rec.seconds_read:.4f}", f"{rec.seconds_map:.4f}",
-                 f"{rec.worn_area_upper * self.window:.9e}",
-                 f"{rec.worn_area_lower * self.window:.9e}", str(rec.deck)]
-                for rec in self.jobs]
-        write_csv(path, self._JOB_COLUMNS, self._prior_jobs + rows)
 
     def _time_index(self, t: float) -> int:
         assert self.results is not None
@@ -864,12 +762,7 @@ class FEContactSolver(FirstBodySolver):
         if depth is None:
             depth = 3.0 * max(result.contact_area, self.dx**2) / (2.0 * self.window)
         depth = _check_positive("depth", depth)
-        if depth > self.stress_depth * (1 + 1e-9):  # a run stops (exit 3), saying how
-            raise FESolverStopped(
-                f"the stress grid asked for reaches {depth:.4g} m below the surface, deeper "
-                f"than the fe solver prints the column stresses ({self.stress_depth:.4g} m); "
-                "set wear.stress_depth (it sets both the criterion's grid and the depth ccx "
-                "prints)")
+        check_stress_depth(depth, self.stress_depth, self.name)  # else exit 3, saying how
         x = self.coords + (result.offset if body == "lower" else 0.0)
         z = np.linspace(0.0, depth, int(nz))
         voigt = self._voigt(self._column_field(body, self._nodal_stress(body, t), x, z), body)
@@ -1052,19 +945,3 @@ class FEContactSolver(FirstBodySolver):
         self.cycle_reports = list(state.get("cycle_reports", []))
         if self.workdir is None and state.get("workdir"):
             self.workdir = Path(state["workdir"])
-
-    def profile(self) -> dict[str, float]:
-        """Seconds spent per job, averaged over the jobs run: meshing (with morphing and the
-        deck), ccx, reading, mapping to the window; and the number of jobs."""
-        if not self.jobs:
-            return {"jobs": 0}
-        keys = ("seconds_mesh", "seconds_ccx", "seconds_read", "seconds_map")
-        return {"jobs": len(self.jobs),
-                **{k: float(np.mean([getattr(j, k) for j in self.jobs])) for k in keys}}
-
-    def write_json(self, path: str | Path) -> Path:
-        """The jobs' records as JSON (for a run folder)."""
-        path = Path(path)
-        path.write_text(json.dumps([{**vars(j), "folder": str(j.folder), "deck": str(j.deck)}
-                                    for j in self.jobs], indent=1))
-        return path

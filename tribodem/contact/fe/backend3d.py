@@ -40,13 +40,9 @@ mirrored to y < 0 (pressure, x traction and x slip even in y; y traction and y s
 
 from __future__ import annotations
 
-import csv
 import io
-import json
 import math
-import tempfile
 import time
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -69,11 +65,8 @@ from tribodem.contact.base import (
 )
 from tribodem.contact.fe.backend import cell_average
 from tribodem.contact.fe.ccx import (
-    CcxConvergenceError,
-    CcxRun,
     FESolverStopped,
     find_ccx,
-    run_ccx,
 )
 from tribodem.contact.fe.crossed import (
     GAUSS_2X2X2,
@@ -93,6 +86,7 @@ from tribodem.contact.fe.deck import (
     _write_ids,
     sliding_contact,
 )
+from tribodem.contact.fe.jobs import CcxJobs, JobRecord, check_stress_depth, run_job
 from tribodem.contact.fe.results import DatBlock, read_dat
 from tribodem.contact.geometry import HertzSphere, crossed_cylinders
 from tribodem.contact.halfspace import max_shear, von_mises
@@ -214,24 +208,7 @@ def _operator(xn: NDArray[np.float64], centres: NDArray[np.float64], dx: float,
     return np.stack([np.interp(centres, xn, e, left=0.0, right=0.0) for e in eye], axis=1)
 
 
-@dataclass
-class JobRecord3D:
-    """One ccx job of the 3D backend: where, what it cost (s) and what it gave."""
-
-    cycle: int  #: the fretting cycle it serves (1-based)
-    folder: Path
-    deck: Path
-    elements: int
-    refine: int  #: increment refinement of the successful attempt (1: none)
-    seconds_mesh: float  #: meshing, morphing and deck writing, s
-    seconds_ccx: float  #: ccx wall clock (all attempts), s
-    seconds_read: float  #: reading the .dat and recovering the tractions, s
-    seconds_map: float = 0.0  #: mapping the fields to the window, s
-    worn_volume_upper: float = 0.0  #: worn volume of the morphed upper body, m^3
-    worn_volume_lower: float = 0.0  #: worn volume of the morphed lower body, m^3
-
-
-class FE3DContactSolver(FirstBodySolver):
+class FE3DContactSolver(CcxJobs, FirstBodySolver):
     """3D CalculiX crossed-cylinder first body, half model (see the module docstring).
 
     ``upper``/``lower``: recessions (m) of a cylinder with its axis along y and one with its
@@ -249,6 +226,7 @@ class FE3DContactSolver(FirstBodySolver):
     ``"elastic"``.
     """
 
+    name = "fe3d"
     capabilities = Capabilities(partial_slip=True, subsurface=True, contacts=("point",))
     #: ccx SMALL SLIDING (pair slave nodes and master faces once per increment): off, the
     #: loading diverged with it (measured, docs/fe3d.md); the lower grid is shifted by h/2
@@ -355,7 +333,7 @@ class FE3DContactSolver(FirstBodySolver):
         #: flip for ever at h = a/2: measured, docs/fe3d.md), stick slope 0.1 x the penalty
         self.settings: ContactSettings = sliding_contact(self.friction, hz.peak_pressure,
                                                          penalty_factor=PENALTY_FACTOR)
-        self.jobs: list[JobRecord3D] = []  #: every ccx job run, in order
+        self.jobs: list[JobRecord] = []  #: every ccx job run, in order
         self._mesh0 = self._base_mesh()
         self._cols = mesh_columns(self._mesh0)
         self._grids = {b: _grid(self._mesh0, b) for b in BODIES}
@@ -590,11 +568,6 @@ class FE3DContactSolver(FirstBodySolver):
         self._k: int | None = None
         self._loaded = False
 
-    def begin_cycle(self) -> None:
-        """Run this cycle's ccx job on the current surfaces (unless the last job was on the
-        same geometry and has served only the first loading)."""
-        self._start_cycle()
-
     def _start_cycle(self) -> None:
         if not (self._key() == self._job_key and self._served and self._fresh_for_cycle):
             self._run_job()
@@ -602,45 +575,13 @@ class FE3DContactSolver(FirstBodySolver):
         self._cycle += 1
         self._k = 0
 
-    def _key(self) -> tuple[bytes, bytes]:
-        wu, wl = self.column_wear()
-        return wu.tobytes(), wl.tobytes()
-
-    def solve_increment(self, offset: float) -> IncrementResult:
-        """Serve the stored increment ending at ``offset`` (m): ``0.0`` after :meth:`reset`
-        is the normal loading; then the cycle's offsets in order (:func:`cycle_offsets` of
-        ``amplitude``, ``n_increments``); anything else is a ``ValueError``."""
-        offset = float(offset)
-        if self._k is None:
-            if offset == 0.0 and not self._loaded:
-                if self._key() != self._job_key or not self._served:
-                    self._run_job()
-                self._fresh_for_cycle = True
-                self._loaded = True
-                assert self._loaded_result is not None
-                return self._loaded_result
-            self._start_cycle()
-        assert self._k is not None
-        expected = float(self.offsets[self._k])
-        if abs(offset - expected) > 1e-9 * self.amplitude:
-            raise ValueError(
-                f"offset = {offset!r} m is not increment {self._k + 1} of the fe3d job's cycle "
-                f"(expected {expected!r} m: amplitude {self.amplitude:g} m, n_increments "
-                f"{self.n_increments}); the fe3d backend serves the cycle 0 -> +A -> 0 -> -A "
-                "-> 0 in order")
-        inc = self._served[self._k]
-        self._k += 1
-        self._loaded = True
-        if self._k == len(self.offsets):
-            self._k = None
-        return inc
+    def _load(self) -> IncrementResult:
+        if self._key() != self._job_key or not self._served:
+            self._run_job()
+        assert self._loaded_result is not None
+        return self._loaded_result
 
     # -- the job --------------------------------------------------------------------------
-    def _folder(self) -> Path:
-        if self.workdir is None:
-            self.workdir = Path(tempfile.mkdtemp(prefix="tribodem-fe3d-"))
-        return self.workdir / f"cycle_{self._cycle + 1:04d}"
-
     def _run_job(self) -> None:
         """Mesh, morph, write, run (retrying with smaller increments) and read one job."""
         t0 = time.perf_counter()
@@ -649,32 +590,15 @@ class FE3DContactSolver(FirstBodySolver):
         mesh = self.morphed_mesh()
         seat = self._seat(mesh)
         t_mesh = time.perf_counter() - t0
-        t_ccx = 0.0
-        run: CcxRun | None = None
-        refine = 1
-        for attempt in range(self.retries + 1):
-            refine = 2**attempt
-            t1 = time.perf_counter()
-            deck = self.write_deck(folder / ("job.inp" if refine == 1 else
-                                             f"job_refine{refine}.inp"), mesh, seat, refine)
-            t_mesh += time.perf_counter() - t1
-            t2 = time.perf_counter()
-            try:
-                run = run_ccx(deck, threads=self.threads, timeout=self.timeout,
-                              executable=self.executable)
-            except CcxConvergenceError:
-                t_ccx += time.perf_counter() - t2
-                if attempt == self.retries:
-                    raise
-                continue
-            t_ccx += time.perf_counter() - t2
-            break
-        assert run is not None
+        run, refine, t_deck, t_ccx = run_job(
+            lambda refine, name: self.write_deck(folder / f"{name}.inp", mesh, seat, refine),
+            self.retries, self.threads, self.timeout, self.executable)
+        t_mesh += t_deck
         t3 = time.perf_counter()
         blocks = read_dat(run.dat)
         states = self._read(blocks, mesh)
         t_read = time.perf_counter() - t3
-        rec = JobRecord3D(cycle=self._cycle + 1, folder=folder, deck=run.job.with_suffix(".inp"),
+        rec = JobRecord(cycle=self._cycle + 1, folder=folder, deck=run.job.with_suffix(".inp"),
                           elements=int(mesh.elements.shape[0]), refine=refine,
                           seconds_mesh=t_mesh, seconds_ccx=t_ccx, seconds_read=t_read,
                           worn_volume_upper=self.worn_volume("upper", mesh),
@@ -687,23 +611,7 @@ class FE3DContactSolver(FirstBodySolver):
         rec.seconds_map = time.perf_counter() - t4
         self._job_key = self._key()
         self.jobs.append(rec)
-        self._write_profile(rec)
-
-    def _write_profile(self, rec: JobRecord3D) -> None:
-        assert self.workdir is not None
-        path = self.workdir / "jobs.csv"
-        row = {"cycle": rec.cycle, "elements": rec.elements, "refine": rec.refine,
-               "seconds_mesh": f"{rec.seconds_mesh:.4f}", "seconds_ccx": f"{rec.seconds_ccx:.3f}",
-               "seconds_read": f"{rec.seconds_read:.4f}", "seconds_map": f"{rec.seconds_map:.4f}",
-               "worn_volume_upper_m3": f"{rec.worn_volume_upper:.9e}",
-               "worn_volume_lower_m3": f"{rec.worn_volume_lower:.9e}",
-               "deck": str(rec.deck)}
-        new = not path.exists()
-        with open(path, "a", newline="") as fh:
-            w = csv.DictWriter(fh, fieldnames=list(row))
-            if new:
-                w.writeheader()
-            w.writerow(row)
+        self._write_profile()
 
     def _read(self, blocks: list[DatBlock], mesh: Mesh3D) -> list[dict[str, Any]]:
         """Per output time of the loaded state and the cycle: total time, forces on the
@@ -887,12 +795,7 @@ class FE3DContactSolver(FirstBodySolver):
         if depth is None:
             depth = 3.0 * math.sqrt(max(result.contact_area, self.dx**2) / math.pi)
         depth = _check_positive("depth", depth)
-        if depth > self.stress_depth * (1 + 1e-9):  # a run stops (exit 3), saying how
-            raise FESolverStopped(
-                f"the stress grid asked for reaches {depth:.4g} m below the surface, deeper "
-                f"than the fe3d solver prints the column stresses ({self.stress_depth:.4g} m); "
-                "set wear.stress_depth (it sets both the criterion's grid and the depth ccx "
-                "prints)")
+        check_stress_depth(depth, self.stress_depth, self.name)  # else exit 3, saying how
         nodal = self._nodal_stress(body, t)
         cols = self._cols[body]  # [ny, nx, nl]
         zc = self.mesh.nodes[cols, 2]
@@ -953,24 +856,8 @@ class FE3DContactSolver(FirstBodySolver):
         if self.workdir is None and state.get("workdir"):
             self.workdir = Path(state["workdir"])
 
-    def profile(self) -> dict[str, float]:
-        """Seconds per job averaged over the jobs run (meshing with morphing and the deck,
-        ccx, reading, mapping to the window) and the number of jobs."""
-        if not self.jobs:
-            return {"jobs": 0}
-        keys = ("seconds_mesh", "seconds_ccx", "seconds_read", "seconds_map")
-        return {"jobs": len(self.jobs),
-                **{k: float(np.mean([getattr(j, k) for j in self.jobs])) for k in keys}}
-
     def report(self) -> dict[str, Any]:
         """For summary.json: the mesh and the jobs' mean time profile (s)."""
         return {"fe3d": {"elements": int(self._mesh0.elements.shape[0]),
                          "h_fine_m": self._mesh0.h_fine, "size_factor": self.size_factor,
                          "profile": self.profile()}}
-
-    def write_json(self, path: str | Path) -> Path:
-        """The jobs' records as JSON (for a run folder)."""
-        path = Path(path)
-        path.write_text(json.dumps([{**vars(j), "folder": str(j.folder), "deck": str(j.deck)}
-                                    for j in self.jobs], indent=1))
-        return path

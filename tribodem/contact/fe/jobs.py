@@ -1,0 +1,198 @@
+"""What the ccx-per-cycle first-body backends (``fe``: 2D, ``fe3d``: 3D) share.
+
+A job's record and the run folder's ``jobs.csv`` / JSON of them, one ccx job run with
+retries at smaller increments, the jobs' mean time profile, serving a cycle's stored
+increments in order, and the stop when a criterion asks for stresses deeper than ccx prints.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import tempfile
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+from tribodem.contact.base import IncrementResult
+from tribodem.contact.fe.ccx import CcxConvergenceError, CcxRun, FESolverStopped, run_ccx
+from tribodem.io.results import write_csv
+
+
+@dataclass
+class JobRecord:
+    """One ccx job of a backend: where, what it cost (s) and what it gave."""
+
+    cycle: int  #: the fretting cycle it serves (1-based)
+    folder: Path
+    deck: Path
+    elements: int
+    refine: int  #: increment refinement of the successful attempt (1: none)
+    seconds_mesh: float  #: meshing, morphing and deck writing, s
+    seconds_ccx: float  #: ccx wall clock (all attempts), s
+    seconds_read: float  #: reading the .dat and recovering the tractions, s
+    seconds_map: float = 0.0  #: mapping the fields to the window, s
+    cycles: int = 1  #: cycles after the loading in the job (chained mode: > 1)
+    worn_volume_upper: float = 0.0  #: worn volume of the morphed upper body, m^3
+    worn_volume_lower: float = 0.0  #: worn volume of the morphed lower body, m^3
+
+
+JOB_COLUMNS = ("cycle", "cycles", "elements", "refine", "seconds_mesh", "seconds_ccx",
+               "seconds_read", "seconds_map", "worn_volume_upper_m3", "worn_volume_lower_m3",
+               "deck")
+
+
+def run_job(write: Callable[[int, str], Path], retries: int, threads: int, timeout: float,
+            executable: str | None) -> tuple[CcxRun, int, float, float]:
+    """Write and run one ccx job, retrying a non-converging one with increments refined
+    2, 4, ... times (``retries`` more attempts; the last failure is raised).
+
+    ``write(refine, name)`` writes the deck ``name`` (``job``, ``job_refine2``, ...) at that
+    refinement and returns its path. Returns (the run, its refinement, seconds writing decks,
+    seconds in ccx over all attempts)."""
+    t_deck = t_ccx = 0.0
+    for attempt in range(retries + 1):
+        refine = 2**attempt
+        t1 = time.perf_counter()
+        deck = write(refine, "job" if attempt == 0 else f"job_refine{refine}")
+        t_deck += time.perf_counter() - t1
+        t2 = time.perf_counter()
+        try:
+            run = run_ccx(deck, threads=threads, timeout=timeout, executable=executable)
+        except CcxConvergenceError:
+            t_ccx += time.perf_counter() - t2
+            if attempt == retries:
+                raise
+            continue
+        return run, refine, t_deck, t_ccx + time.perf_counter() - t2
+    raise AssertionError("unreachable")  # pragma: no cover
+
+
+def check_stress_depth(depth: float, printed: float, backend: str) -> None:
+    """Stop the run (:class:`FESolverStopped`, exit 3) when a stress grid ``depth`` (m) goes
+    deeper than the columns ``backend`` has ccx print (``printed``, m), saying what to set."""
+    if depth > printed * (1 + 1e-9):
+        raise FESolverStopped(
+            f"the stress grid asked for reaches {depth:.4g} m below the surface, deeper "
+            f"than the {backend} solver prints the column stresses ({printed:.4g} m); "
+            "set wear.stress_depth (it sets both the criterion's grid and the depth ccx "
+            "prints)")
+
+
+class CcxJobs:
+    """Mixin of the ccx-per-cycle backends: the work folder, the jobs' records and profile,
+    and serving a cycle's increments. The backend sets ``name``, ``workdir``, ``jobs``,
+    ``_cycle``, ``_k``, ``_served``, ``offsets``, ``amplitude`` and ``n_increments``."""
+
+    name: str
+    workdir: Path | None
+    jobs: list[JobRecord]
+    offsets: NDArray[np.float64]
+    amplitude: float
+    n_increments: int
+    _cycle: int
+    _k: int | None
+    _served: list[IncrementResult]
+    _prior_jobs: list[list[str]] | None = None
+
+    def _folder(self) -> Path:
+        """This cycle's job folder (a temporary work folder if none was given)."""
+        if self.workdir is None:
+            self.workdir = Path(tempfile.mkdtemp(prefix=f"tribodem-{self.name}-"))
+        return self.workdir / f"cycle_{self._cycle + 1:04d}"
+
+    _loaded: bool
+    _fresh_for_cycle: bool = False
+
+    def column_wear(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Worn depth (m) at each node column of the (upper, lower) body."""
+        raise NotImplementedError
+
+    def _start_cycle(self) -> None:
+        """Make the next cycle's increments (a job, or the next cycle of one) and serve it."""
+        raise NotImplementedError
+
+    def _load(self) -> IncrementResult:
+        """The first loading's increment, running the loading's job if it is not run."""
+        raise NotImplementedError
+
+    def _key(self) -> tuple[bytes, bytes]:
+        """The geometry a job was run on: the column wear of both bodies."""
+        wu, wl = self.column_wear()
+        return wu.tobytes(), wl.tobytes()
+
+    def begin_cycle(self) -> None:
+        """Make this cycle's increments: a ccx job on the current surfaces, unless the job
+        already run serves it (the loading's job, or the next cycle of a chain)."""
+        self._start_cycle()
+
+    def solve_increment(self, offset: float) -> IncrementResult:
+        """Serve the stored increment ending at ``offset`` (m): ``0.0`` after ``reset`` is
+        the normal loading; then the cycle's offsets in order (:func:`cycle_offsets` of
+        ``amplitude``, ``n_increments``); anything else is a ``ValueError``."""
+        offset = float(offset)
+        if self._k is None:
+            if offset == 0.0 and not self._loaded:
+                inc = self._load()
+                self._fresh_for_cycle = True  # the first cycle may reuse the loading's job
+                self._loaded = True
+                return inc
+            self._start_cycle()
+        inc = self._next_increment(offset)
+        self._loaded = True
+        return inc
+
+    def _next_increment(self, offset: float) -> IncrementResult:
+        """The stored increment ending at ``offset`` (m), the next of the cycle in order;
+        anything else is a ``ValueError``."""
+        assert self._k is not None
+        expected = float(self.offsets[self._k])
+        if abs(offset - expected) > 1e-9 * self.amplitude:
+            raise ValueError(
+                f"offset = {offset!r} m is not increment {self._k + 1} of the {self.name} "
+                f"job's cycle (expected {expected!r} m: amplitude {self.amplitude:g} m, "
+                f"n_increments {self.n_increments}); the {self.name} backend serves the cycle "
+                "0 -> +A -> 0 -> -A -> 0 in order")
+        inc = self._served[self._k]
+        self._k += 1
+        if self._k == len(self.offsets):
+            self._k = None
+        return inc
+
+    def _write_profile(self) -> None:
+        """``workdir/jobs.csv``: one row per job (with the rows of an earlier session of a
+        resumed run), rewritten atomically whenever a job is run or its fields are mapped."""
+        assert self.workdir is not None
+        path = self.workdir / "jobs.csv"
+        if self._prior_jobs is None:
+            self._prior_jobs = []
+            if path.exists():
+                with open(path, newline="") as fh:
+                    rows = list(csv.reader(fh))
+                if rows and tuple(rows[0]) == JOB_COLUMNS:
+                    self._prior_jobs = rows[1:]
+        rows = [[rec.cycle, rec.cycles, rec.elements, rec.refine, f"{rec.seconds_mesh:.4f}",
+                 f"{rec.seconds_ccx:.3f}", f"{rec.seconds_read:.4f}", f"{rec.seconds_map:.4f}",
+                 f"{rec.worn_volume_upper:.9e}", f"{rec.worn_volume_lower:.9e}", str(rec.deck)]
+                for rec in self.jobs]
+        write_csv(path, JOB_COLUMNS, self._prior_jobs + rows)
+
+    def profile(self) -> dict[str, float]:
+        """Seconds spent per job, averaged over the jobs run: meshing (with morphing and the
+        deck), ccx, reading, mapping to the window; and the number of jobs."""
+        if not self.jobs:
+            return {"jobs": 0}
+        keys = ("seconds_mesh", "seconds_ccx", "seconds_read", "seconds_map")
+        return {"jobs": len(self.jobs),
+                **{k: float(np.mean([getattr(j, k) for j in self.jobs])) for k in keys}}
+
+    def write_json(self, path: str | Path) -> Path:
+        """The jobs' records as JSON (for a run folder)."""
+        path = Path(path)
+        path.write_text(json.dumps([{**vars(j), "folder": str(j.folder), "deck": str(j.deck)}
+                                    for j in self.jobs], indent=1))
+        return path
