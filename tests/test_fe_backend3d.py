@@ -247,3 +247,44 @@ def test_command_runs_and_resumes(tmp_path: Path) -> None:
     assert float(jobs[1]["worn_volume_upper_m3"]) > 0.0  # cycle 2 ran on the morphed mesh
     for k in (1, 2):
         assert (out / "fe" / f"cycle_{k:04d}" / "job.dat").is_file()
+
+
+# --- elastic-plastic bodies: Johnson's first yield -------------------------------------------
+
+def test_plastic_first_yield_under_the_surface(tmp_path: Path) -> None:
+    """Johnson's first yield of a frictionless point contact (von Mises, nu = 0.3): p0 =
+    1.60 Y at 0.48 a under the surface. The normal loading (nearly frictionless, the deck's
+    seating friction) at Hertz p0 = 0.9 x 1.60 Y leaves no plastic strain; at 1.2 x 1.60 Y
+    both bodies yield, the peak plastic strain within h / 2 of 0.48 a deep (the Gauss point
+    nearest it on an h = a / 2 mesh). Sliding at mu 0.6 then yields both at the surface
+    (Johnson 7.3: mu > 0.3 moves first yield to the surface), and the report and plastic
+    steps carry it. Two ccx jobs of 16 increments per cycle (fewer failed on the return
+    strokes, docs/fe3d.md)."""
+    from tribodem.materials.en24t import EN24T
+
+    y = EN24T.yield_strength
+    for factor in (0.9, 1.2):
+        load = LOAD * (factor * 1.60 * y / P0) ** 3  # p0 ~ P^(1/3)
+        solver = _solver(tmp_path / f"f{factor}", load=load, h_over_a=0.5,
+                         material="elastic-plastic", plastic_increments=16)
+        assert solver.capabilities.plastic and not solver.capabilities.plastic_every_cycle
+        solver.reset()
+        solver.solve_increment(0.0)
+        solver.begin_cycle()
+        incs = [solver.solve_increment(float(o)) for o in solver.offsets]
+        rep = solver.report()["cycles"][-1]
+        a, h = solver.hertz[1], solver._mesh0.h_fine
+        for body in ("upper", "lower"):
+            loaded = rep[f"max_peeq_loaded_{body}"]
+            if factor < 1.0:
+                assert loaded == 0.0, (body, loaded)
+            else:
+                assert loaded > 1e-5, (body, loaded)
+                assert abs(rep[f"max_peeq_loaded_depth_{body}_m"] - 0.48 * a) <= 0.5 * h
+            assert rep[f"max_peeq_{body}"] > max(loaded, 1e-4)  # the sliding adds to it
+            assert rep[f"max_peeq_depth_{body}_m"] < 0.25 * h  # at the surface Gauss point
+        assert rep["max_s22_compressive_pa"] > 0.8 * factor * 1.60 * y
+        steps = solver.plastic_steps()
+        assert len(steps) == 2 * (1 + len(incs))  # the loading and each increment, per body
+        assert {s.body for s in steps} == {"upper", "lower"}
+        assert solver.plastic_steps() == []  # forgotten once read

@@ -58,12 +58,19 @@ from tribodem.contact.base import (
     IncrementResult,
     Recession,
     SubsurfaceStress,
+    Unsupported,
     WindowTooSmallError,
     _check_positive,
     contact_modulus,
     cycle_offsets,
 )
-from tribodem.contact.fe.backend import cell_average
+from tribodem.contact.elastoplastic import PlasticStep
+from tribodem.contact.fe.backend import (
+    MATERIALS,
+    PLASTIC_LOAD_INCREMENTS,
+    PLASTIC_MIN_INCREMENTS,
+    cell_average,
+)
 from tribodem.contact.fe.ccx import (
     FESolverStopped,
     find_ccx,
@@ -90,6 +97,7 @@ from tribodem.contact.fe.jobs import CcxJobs, JobRecord, check_stress_depth, run
 from tribodem.contact.fe.results import DatBlock, read_dat
 from tribodem.contact.geometry import HertzSphere, crossed_cylinders
 from tribodem.contact.halfspace import max_shear, von_mises
+from tribodem.materials.en24t import EN24T
 
 #: default element size at the contact / Hertz radius of the 3D backend (a/3: Hertz p0 and
 #: a within 3 % on the window, gross slip within 0.5 %, 4-8 min per +-25 um cycle on the
@@ -109,6 +117,26 @@ MODES = ("fresh",)
 #: its inverse extrapolates Gauss-point values to the nodes
 _N_AT_GP = np.prod(1.0 + GAUSS_2X2X2[:, None, :] * NODE_XI[None, :, :], axis=2) / 8.0
 _EXTRAPOLATE3 = np.linalg.inv(_N_AT_GP)
+#: the Gauss point nearest each C3D8 node (the one in the node's octant), [8 nodes]
+_NEAREST_GAUSS3 = np.argmax(NODE_XI @ GAUSS_2X2X2.T, axis=1)
+
+
+#: mirror signs (y -> -y) of the stress components (ccx order xx, yy, zz, xy, xz, yz) and
+#: of a scalar
+_STRESS_MIRROR = np.array([1.0, 1.0, 1.0, -1.0, 1.0, -1.0])
+_ONE = np.ones(1)
+
+
+def _voigt(s: NDArray[np.float64], body: str) -> NDArray[np.float64]:
+    """ccx-order stress [..., 6] (lab frame, z up) to the contract's frame (z = depth into
+    ``body``: xz and yz flip under the lower body), Voigt xx, yy, zz, yz, xz, xy."""
+    sign = -1.0 if body == "lower" else 1.0
+    voigt = np.empty_like(s)
+    voigt[..., 0], voigt[..., 1], voigt[..., 2] = s[..., 0], s[..., 1], s[..., 2]
+    voigt[..., 3] = sign * s[..., 5]
+    voigt[..., 4] = sign * s[..., 4]
+    voigt[..., 5] = s[..., 3]
+    return voigt
 
 
 def _curvatures(f: Recession, h: float = 10e-6) -> tuple[float, float]:
@@ -227,7 +255,23 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
     """
 
     name = "fe3d"
-    capabilities = Capabilities(partial_slip=True, subsurface=True, contacts=("point",))
+    #: the class's widest capabilities; an instance's are :meth:`capabilities_for` its
+    #: ``material`` (fresh mode only: plastic strain of one cycle at a time)
+    capabilities = Capabilities(plastic=True, partial_slip=True, subsurface=True,
+                                contacts=("point",))
+
+    @classmethod
+    def capabilities_for(cls, options: dict[str, Any]) -> Capabilities:
+        """Plastic strain with ``material = "elastic-plastic"``; never ``plastic_every_cycle``
+        (a fresh job starts every cycle from virgin bodies: the 2D backend's ``chained`` mode
+        is not built in 3D)."""
+        plastic = options.get("material", "elastic") == "elastic-plastic"
+        return Capabilities(plastic=plastic, partial_slip=True, subsurface=True,
+                            contacts=("point",))
+
+    @classmethod
+    def options_for(cls, names: set[str]) -> str:
+        return "fe.material = 'elastic-plastic'" if names == {"plastic"} else ""
     #: ccx SMALL SLIDING (pair slave nodes and master faces once per increment): off, the
     #: loading diverged with it (measured, docs/fe3d.md); the lower grid is shifted by h/2
     #: along x instead, so no slave node sits on a master node
@@ -250,6 +294,11 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         mode: str = "fresh",
         material: str = "elastic",
         chain_cycles: int = 5,
+        plastic_increments: int = PLASTIC_MIN_INCREMENTS,
+        yield_strength: float = EN24T.yield_strength,
+        uts: float = EN24T.uts,
+        uts_strain: float = EN24T.uts_strain,
+        hardening: float | None = None,
         h_over_a: float = FRETTING3D_H_OVER_A,
         size_factor: float = FRETTING3D_SIZE_FACTOR,
         growth: float = FRETTING3D_GROWTH,
@@ -261,8 +310,15 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         stress_depth: float | None = None,
         regime: str = "gross",
         tolerance: float | None = None,
+        ep_n: int | None = None,
+        ep_nz: int | None = None,
+        ep_window_radii: float | None = None,
+        ep_depth_radii: float | None = None,
+        load_steps: int | None = None,
+        ep_tolerance: float | None = None,
     ) -> None:
         del regime, tolerance, chain_cycles  # not used (see the class docstring)
+        del ep_n, ep_nz, ep_window_radii, ep_depth_radii, load_steps, ep_tolerance
         if (upper is None) != (lower is None):
             raise ValueError("upper and lower must both be given or both be None (defaults)")
         if upper is None or lower is None:
@@ -273,9 +329,22 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         if mode not in MODES:
             raise ValueError(f"mode = {mode!r} is not allowed for the fe3d backend: allowed: "
                              f"{', '.join(MODES)}")
-        if material != "elastic":
-            raise ValueError(f"material = {material!r} is not allowed for the fe3d backend "
-                             "(elastic bodies only); allowed: 'elastic'")
+        if material not in MATERIALS:
+            raise ValueError(f"material = {material!r} is not allowed: allowed: "
+                             f"{', '.join(MATERIALS)}")
+        self.material = material
+        self.plastic = material == "elastic-plastic"
+        if int(plastic_increments) != plastic_increments or plastic_increments < 4:
+            raise ValueError(f"plastic_increments = {plastic_increments!r} is not allowed: "
+                             "an integer >= 4")
+        self.plastic_increments = int(plastic_increments)
+        self.capabilities = self.capabilities_for({"material": material})
+        self.plastic_law = FEMaterial(
+            yield_strength=_check_positive("yield_strength", yield_strength),
+            uts=_check_positive("uts", uts), uts_strain=_check_positive("uts_strain", uts_strain),
+            hardening=hardening)
+        if self.plastic:
+            self.plastic_law.plastic_table()  # ValueError on an impossible law
         self.mode = mode
         self.executable = find_ccx(executable)
         self.upper, self.lower = upper, lower
@@ -308,6 +377,10 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         self.amplitude = _check_positive("amplitude", amplitude)
         self.offsets = cycle_offsets(self.amplitude, n_increments)
         self.n_increments = int(n_increments)
+        #: ccx increments per output increment of the cycle (plastic: at least
+        #: ``plastic_increments`` per cycle)
+        self.cycle_refine = (math.ceil(self.plastic_increments / self.n_increments)
+                             if self.plastic else 1)
         self.h_over_a = _check_positive("h_over_a", h_over_a)
         self.size_factor = _check_positive("size_factor", size_factor)
         if self.size_factor * a > 0.5 * self.radius:
@@ -370,6 +443,9 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         self._fresh_for_cycle = False
         self._time_of: dict[int, float] = {}
         self._nodal_cache: dict[tuple[str, float], NDArray[np.float64]] = {}
+        self._peeq_cache: dict[tuple[str, str, float], NDArray[np.float64]] = {}
+        self._pending: list[PlasticStep] = []
+        self.cycle_reports: list[dict[str, Any]] = []  #: :meth:`_cycle_report` per job
         self.mesh: Mesh3D = self._mesh0  #: the (morphed) mesh of the last job
 
     # -- geometry -------------------------------------------------------------------------
@@ -475,7 +551,17 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
 
     def _materials(self) -> tuple[FEMaterial, FEMaterial]:
         lo, up = self.lower_material, self.upper_material
-        return FEMaterial(lo.young, lo.poisson), FEMaterial(up.young, up.poisson)
+        law = self.plastic_law
+        y = law.yield_strength if self.plastic else None
+        return tuple(FEMaterial(b.young, b.poisson, yield_strength=y, uts=law.uts,  # type: ignore[return-value]
+                                uts_strain=law.uts_strain, hardening=law.hardening)
+                     for b in (lo, up))
+
+    @property
+    def plastic_depth(self) -> float:
+        """Depth of the grid of :meth:`plastic_steps`, m: 1.5 Hertz radii (first yield of a
+        point contact at 0.48 a, shallower with friction), at most the printed column depth."""
+        return min(1.5 * self.hertz[1], self.stress_depth)
 
     # -- the deck ---------------------------------------------------------------------------
     def write_deck(self, path: str | Path, mesh: Mesh3D, seat: float, refine: int = 1) -> Path:
@@ -507,6 +593,9 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         out.write("*SURFACE, NAME=SLOW, TYPE=ELEMENT\nLCONT, S2\n")
         for name, m in (("MLOWER", lo_m), ("MUPPER", up_m)):
             out.write(f"*MATERIAL, NAME={name}\n*ELASTIC\n{_fmt(m.young)}, {m.poisson}\n")
+            table = m.plastic_table()
+            if table:
+                out.write("*PLASTIC\n" + "".join(f"{_fmt(v)}, {_fmt(e)}\n" for v, e in table))
         out.write("*SOLID SECTION, ELSET=LOWER, MATERIAL=MLOWER\n"
                   "*SOLID SECTION, ELSET=UPPER, MATERIAL=MUPPER\n")
         ref = int(mesh.node_sets["REF"][0])
@@ -523,9 +612,9 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         out.write(f"*FRICTION\n{mu}, {_fmt(s.stick_factor * k_n)}\n")
         sliding = ", SMALL SLIDING" if self.small_sliding else ""
         out.write(f"*CONTACT PAIR, INTERACTION=SI, TYPE={s.formulation}{sliding}\nSUP, SLOW\n")
-        n_load = 4
+        n_load = PLASTIC_LOAD_INCREMENTS if self.plastic else 4
         q = self.n_increments // 4
-        _time_points(out, "TLOAD", np.arange(1, n_load + 1) / n_load)
+        _time_points(out, "TLOAD", np.arange(1, 5) / 4.0)  # outputs: 4 per load step
         _time_points(out, "TQUARTER", np.arange(1, q + 1) / q)
         fixed = "SYMY, 2, 2\nLBOT, 1, 3\n"
         out.write("*BOUNDARY\n" + fixed)
@@ -540,7 +629,10 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
                     f"*NODE PRINT, NSET=LTOP, TIME POINTS={tp}\nU\n"
                     f"*EL PRINT, ELSET=UCONT, TIME POINTS={tp}\nS\n"
                     f"*EL PRINT, ELSET=UCOL, TIME POINTS={tp}\nS\n"
-                    f"*EL PRINT, ELSET=LCOL, TIME POINTS={tp}\nS\n")
+                    f"*EL PRINT, ELSET=LCOL, TIME POINTS={tp}\nS\n"
+                    + (f"*EL PRINT, ELSET=UCOL, TIME POINTS={tp}\nPEEQ\n"
+                       f"*EL PRINT, ELSET=LCOL, TIME POINTS={tp}\nPEEQ\n"
+                       if self.plastic else ""))
 
         refine = max(int(refine), 1)
         out.write("*STEP, INC=200\n*STATIC\n0.5, 1., 1e-4, 0.5\n")
@@ -551,13 +643,21 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         out.write("*BOUNDARY, OP=NEW\n" + fixed + f"{ref}, 1, 1, 0.\n")
         out.write(f"*CLOAD\n{ref}, 3, {_fmt(-self.load / 2.0)}\n")
         out.write(outputs("TLOAD") + "*END STEP\n")
-        dt = 4.0 / (self.n_increments * refine)
+        dt = 4.0 / (self.n_increments * refine * self.cycle_refine)
         for k, target in enumerate((self.amplitude, 0.0, -self.amplitude, 0.0)):
             out.write(f"*STEP, INC=10000\n*STATIC\n{dt}, 1., {dt * 1e-4}, {dt}\n")
             if k == 0:
                 out.write(friction(s.mu, s.stick_factor))
             out.write(f"*BOUNDARY\n{ref}, 1, 1, {_fmt(target)}\n")
             out.write(outputs("TQUARTER") + "*END STEP\n")
+        if self.plastic:  # lift the upper body off, load removed: the residual surfaces
+            a = self.hertz[1]
+            dt = 1.0 / (n_load * refine)
+            out.write(f"*STEP, INC=1000\n*STATIC\n{dt}, 1., {dt * 1e-4}, {dt}\n")
+            out.write("*BOUNDARY, OP=NEW\n" + fixed + f"{ref}, 1, 1, 0.\n"
+                      f"{ref}, 3, 3, {_fmt(2.0 * a * a / self.radius)}\n"
+                      f"*CLOAD, OP=NEW\n{ref}, 3, 0.\n")
+            out.write(outputs("TLOAD") + "*END STEP\n")
         path = Path(path)
         path.write_text(out.getvalue())
         return path
@@ -608,6 +708,10 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         self._blocks = blocks
         self._states = states
         self._serve(states)
+        self._peeq_cache = {}
+        if self.plastic:
+            self._pending = self._plastic_steps_of_job()
+        self.cycle_reports.append(self._cycle_report())
         rec.seconds_map = time.perf_counter() - t4
         self._job_key = self._key()
         self.jobs.append(rec)
@@ -796,12 +900,26 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
             depth = 3.0 * math.sqrt(max(result.contact_area, self.dx**2) / math.pi)
         depth = _check_positive("depth", depth)
         check_stress_depth(depth, self.stress_depth, self.name)  # else exit 3, saying how
-        nodal = self._nodal_stress(body, t)
+        x = self.coords + (result.offset if body == "lower" else 0.0)
+        z = np.linspace(0.0, depth, int(nz))
+        s = self._column_grid(body, self._nodal_stress(body, t), _STRESS_MIRROR, x, z,
+                              "stresses")
+        voigt = _voigt(s, body)
+        return SubsurfaceStress(body=body, z=z, x=self.coords, y=self.coords, stress=voigt,
+                                von_mises=von_mises(voigt), tresca=max_shear(voigt))
+
+    def _column_grid(self, body: str, nodal: NDArray[np.float64], mirror: NDArray[np.float64],
+                     x: NDArray[np.float64], z: NDArray[np.float64], what: str
+                     ) -> NDArray[np.float64]:
+        """A nodal field [n_nodes, c] (NaN off the column set) under ``body`` on the grid
+        (z depths below the worn surface, x, the window's y), [nz, nx, ny, c]: linear along
+        each straight node column by the depth below its surface node, then bilinear between
+        columns; y < 0 from the mirror (component signs ``mirror``). ``ValueError`` where the
+        grid leaves the printed columns."""
         cols = self._cols[body]  # [ny, nx, nl]
         zc = self.mesh.nodes[cols, 2]
         d = np.abs(zc - zc[..., :1])  # depth below the surface node, increasing
-        z = np.linspace(0.0, depth, int(nz))
-        v = nodal[cols]  # [ny, nx, nl, 6]
+        v = nodal[cols]  # [ny, nx, nl, c]
         ok = np.isfinite(v[..., 0])
         # first nl with the depth: k such that d[k] <= z < d[k + 1]
         k = np.clip((d[..., None, :] <= z[:, None]).sum(axis=-1) - 1, 0, d.shape[-1] - 2)
@@ -810,37 +928,173 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         w = np.clip((z - d0) / (d1 - d0), 0.0, 1.0)[..., None]
         v0 = np.take_along_axis(v, k[..., None], axis=2)
         v1 = np.take_along_axis(v, (k + 1)[..., None], axis=2)
-        prof = (1 - w) * v0 + w * v1  # [ny, nx, nz, 6]
+        prof = (1 - w) * v0 + w * v1  # [ny, nx, nz, c]
         good = np.take_along_axis(ok, k, axis=-1) & np.take_along_axis(ok, k + 1, axis=-1)
-        x = self.coords + (result.offset if body == "lower" else 0.0)
-        y = self.coords
-        full = np.concatenate([prof[:0:-1] * np.array([1, 1, 1, -1, 1, -1]), prof], axis=0)
+        full = np.concatenate([prof[:0:-1] * mirror, prof], axis=0)
         gfull = np.concatenate([good[:0:-1], good], axis=0)
+        y = self.coords
         X, Y = np.meshgrid(x, y, indexing="ij")
         xb = self._grids[body][0]
-        s = _bilinear(xb, self._ys_full, full.reshape(full.shape[0], full.shape[1], -1),
-                      X.ravel(), Y.ravel()).reshape(self.n, self.n, z.size, 6)
+        c = v.shape[-1]
+        out = _bilinear(xb, self._ys_full, full.reshape(full.shape[0], full.shape[1], -1),
+                        X.ravel(), Y.ravel()).reshape(x.size, y.size, z.size, c)
         gi = _bilinear(xb, self._ys_full,
                        gfull.astype(float).reshape(gfull.shape[0], gfull.shape[1], -1),
                        X.ravel(), Y.ravel())
         if np.any(gi < 1.0 - 1e-12):
-            raise ValueError(f"no column stresses under the window down to depth {depth:.4g} m "
-                             f"on the {body} body")
-        s = np.moveaxis(s, 2, 0)  # [nz, n, n, 6] ccx order
-        sign = -1.0 if body == "lower" else 1.0  # z = depth: flipped under the lower body
-        voigt = np.empty_like(s)
-        voigt[..., 0], voigt[..., 1], voigt[..., 2] = s[..., 0], s[..., 1], s[..., 2]
-        voigt[..., 3] = sign * s[..., 5]
-        voigt[..., 4] = sign * s[..., 4]
-        voigt[..., 5] = s[..., 3]
-        return SubsurfaceStress(body=body, z=z, x=self.coords, y=self.coords, stress=voigt,
-                                von_mises=von_mises(voigt), tresca=max_shear(voigt))
+            raise ValueError(f"no column {what} under the window down to depth "
+                             f"{z[-1]:.4g} m on the {body} body")
+        return np.moveaxis(out, 2, 0)
+
+    # -- plastic strain -------------------------------------------------------------------
+    def _nodal_peeq(self, body: str, t: float) -> NDArray[np.float64]:
+        """Equivalent plastic strain at the nodes at total time ``t``, [n_nodes, 1] (NaN off
+        the column set): each node takes the mean, over the elements around it, of the
+        element's Gauss point nearest to it (no extrapolation: >= 0, no overshoot at the
+        surface where plastic strain is steepest)."""
+        key = ("peeq", body, t)
+        if key not in self._peeq_cache:
+            elems, ip = self._peeq_ip(body, t)
+            conn = self.mesh.elements[elems - 1]
+            n_nodes = self.mesh.nodes.shape[0]
+            total = np.zeros(n_nodes)
+            count = np.zeros(n_nodes)
+            np.add.at(total, conn, ip[:, _NEAREST_GAUSS3])
+            np.add.at(count, conn, 1.0)
+            with np.errstate(invalid="ignore", divide="ignore"):
+                self._peeq_cache[key] = (total / count)[:, None]
+        return self._peeq_cache[key]
+
+    def _peeq_ip(self, body: str, t: float) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
+        """(elements, PEEQ at their 8 Gauss points [m, 8]) of ``body``'s column set at ``t``."""
+        name = "LCOL" if body == "lower" else "UCOL"
+        block = next(b for b in self._blocks if b.kind == "equivalent plastic strain"
+                     and b.set_name == name and abs(b.time - t) < 1e-9)
+        rows = block.rows
+        return rows[:, 0].astype(np.int64).reshape(-1, 8)[:, 0], rows[:, 2].reshape(-1, 8)
+
+    def _peeq_peak(self, body: str, t: float) -> tuple[float, float]:
+        """(max equivalent plastic strain over ``body``'s column set at ``t`` (Gauss points),
+        its depth below the body's (worn) surface, m)."""
+        elems, pe = self._peeq_ip(body, t)
+        e, g = np.unravel_index(int(np.argmax(pe)), pe.shape)
+        xyz = _N_AT_GP[g] @ self.mesh.nodes[self.mesh.elements[elems[e] - 1]]
+        xs, ys = self._grids[body]
+        z_top = self.mesh.nodes[self._cols[body][..., 0], 2][..., None]
+        z_surf = _bilinear(xs, ys, z_top, np.array([xyz[0]]), np.array([abs(xyz[1])]))[0, 0]
+        return float(pe[e, g]), float(abs(xyz[2] - z_surf))
+
+    def _plastic_grid_x(self, body: str) -> NDArray[np.float64]:
+        """x of the plastic-step grid: the window (upper, its own frame) or the window plus
+        the stroke (lower, lab frame) at the window spacing, m."""
+        if body == "upper":
+            return self.coords
+        pad = math.ceil(self.amplitude / self.dx) + 1
+        return (np.arange(-pad, self.n + pad) - self.n // 2) * self.dx
+
+    def _plastic_steps_of_job(self) -> list[PlasticStep]:
+        """The job's plastic steps, one per body per output increment: the loading (from the
+        virgin state to the load) and each increment of the cycle, on [17, nx, n] grids
+        down to :attr:`plastic_depth` (upper: window frame; lower: lab frame over the window
+        plus the stroke, y the window's)."""
+        z = np.linspace(0.0, self.plastic_depth, 17)
+        steps: list[PlasticStep] = []
+        times = sorted(self._state_of)
+        prev: float | None = None
+        for t in times:
+            load = float(abs(self._state_of[t]["force"][2]))
+            for body in BODIES:
+                x = self._plastic_grid_x(body)
+                now = self._nodal_peeq(body, t)
+                dp_nodal = now if prev is None else now - self._nodal_peeq(body, prev)
+                dp = np.maximum(self._column_grid(body, dp_nodal, _ONE, x, z,
+                                                  "plastic strain")[..., 0], 0.0)
+                stress = _voigt(self._column_grid(body, self._nodal_stress(body, t),
+                                                  _STRESS_MIRROR, x, z, "stresses"), body)
+                steps.append(PlasticStep(z=z, x=x, y=self.coords, body=body, load=load,
+                                         dp=dp, stress=stress))
+            prev = t
+        return steps
+
+    def plastic_steps(self) -> list[PlasticStep]:
+        """The plastic steps solved since the last call (then forgotten): the loading and
+        every output increment of the cycle of the last job, one step per body
+        (:attr:`PlasticStep.body`)."""
+        if not self.plastic:
+            raise Unsupported("the fe3d solver gives plastic strain with material = "
+                              "'elastic-plastic'")
+        out, self._pending = self._pending, []
+        return out
+
+    # -- what a cycle measured -------------------------------------------------------------
+    def _cycle_report(self) -> dict[str, Any]:
+        """Peak stresses, plastic strain, pile-up and traction of the job just run (one
+        fretting cycle from virgin bodies); see :meth:`report`."""
+        times = sorted(self._state_of)
+        row: dict[str, Any] = {"cycle": self._cycle + 1}
+        vm_max = s33_c = s33_t = 0.0
+        for name in ("UCOL", "LCOL"):
+            for t in times:
+                block = next(b for b in self._blocks if b.kind == "stresses"
+                             and b.set_name == name and abs(b.time - t) < 1e-9)
+                sv = block.rows[:, 2:8]
+                vm = np.sqrt(0.5 * ((sv[:, 0] - sv[:, 1]) ** 2 + (sv[:, 1] - sv[:, 2]) ** 2
+                                    + (sv[:, 2] - sv[:, 0]) ** 2)
+                             + 3.0 * (sv[:, 3] ** 2 + sv[:, 4] ** 2 + sv[:, 5] ** 2))
+                vm_max = max(vm_max, float(vm.max()))
+                s33_c = max(s33_c, float(-sv[:, 2].min()))
+                s33_t = max(s33_t, float(sv[:, 2].max()))
+        row |= {"max_von_mises_pa": vm_max, "max_s22_compressive_pa": s33_c,
+                "max_s22_tensile_pa": s33_t}
+        if self.plastic:
+            for body in BODIES:
+                for label, t in (("", times[-1]), ("loaded_", times[0])):
+                    peak, depth = self._peeq_peak(body, t)
+                    row[f"max_peeq_{label}{body}"] = peak
+                    row[f"max_peeq_{label}depth_{body}_m"] = depth
+            # after lifting the upper body off: pile-up (largest rise of the lower surface,
+            # and of the upper one towards it relative to REF) and dent (deepest depression)
+            t_off = max(b.time for b in self._blocks if b.kind == "displacements")
+            u = {name: next(b for b in self._blocks if b.kind == "displacements"
+                            and b.set_name == name and abs(b.time - t_off) < 1e-9).rows
+                 for name in ("UBOT", "LTOP", "REF")}
+            u_lo = u["LTOP"][:, 3]
+            u_up = u["UBOT"][:, 3] - u["REF"][0, 3]
+            row |= {"pile_up_lower_m": float(max(u_lo.max(), 0.0)),
+                    "dent_lower_m": float(max(-u_lo.min(), 0.0)),
+                    "pile_up_upper_m": float(max(-u_up.min(), 0.0)),
+                    "dent_upper_m": float(max(u_up.max(), 0.0))}
+        q = np.array([float(np.hypot(*np.moveaxis(i.traction, -1, 0)).max())
+                      for i in self._served])
+        quarter = max(len(q) // 4, 1)
+        first, last = float(q[:quarter].max()), float(q[-quarter:].max())
+        row |= {"max_traction_first_quarter_pa": first, "max_traction_last_quarter_pa": last,
+                "traction_drop": (last - first) / first if first > 0 else 0.0}
+        fx = [abs(float(self._state_of[times[k]]["force"][0])) for k in (quarter, 3 * quarter)]
+        row["q_over_mu_p_at_plus_minus_a"] = [v / (self.friction * self.load) for v in fx]
+        return row
+
+    def report(self) -> dict[str, Any]:
+        """For summary.json: the mesh, material, the jobs' mean time profile (s) and per
+        cycle (:meth:`_cycle_report`): max von Mises and max S22 (the vertical normal stress,
+        ccx S33; compressive and tensile) over the column sets' Gauss points at the loaded
+        state and every output increment; with plastic bodies the max equivalent plastic
+        strain per body and its depth at the cycle's end and at the loaded state
+        (``max_peeq_loaded_*``: Johnson's first yield, below the surface), the residual
+        pile-up and dent
+        after lifting the upper body off; the largest shear traction in the cycle's first
+        and last quarters and the drop between them, |Q| / (mu P) at +A and -A."""
+        return {"backend": "fe3d", "mode": self.mode, "material": self.material,
+                "fe3d": {"elements": int(self._mesh0.elements.shape[0]),
+                         "h_fine_m": self._mesh0.h_fine, "size_factor": self.size_factor},
+                "profile": self.profile(), "cycles": list(self.cycle_reports)}
 
     # -- resume ---------------------------------------------------------------------------
     def state_dict(self) -> dict[str, Any]:
         """A fresh-mode solver holds no load history between cycles: the cycle counter,
         whether the bodies were loaded, the mode and the work folder."""
         return {"cycle": self._cycle, "loaded": self._loaded, "mode": self.mode,
+                "material": self.material, "cycle_reports": list(self.cycle_reports),
                 "workdir": None if self.workdir is None else str(self.workdir)}
 
     def load_state_dict(self, state: dict[str, Any]) -> None:
@@ -848,16 +1102,15 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         if state.get("mode", "fresh") != self.mode:
             raise ValueError(f"saved fe3d mode {state.get('mode')!r}, this solver "
                              f"{self.mode!r}")
+        if state.get("material", "elastic") != self.material:
+            raise ValueError(f"saved fe3d material {state.get('material')!r}, this solver "
+                             f"{self.material!r}")
         self._cycle = int(state["cycle"])
         self._loaded = bool(state["loaded"])
         self._k = None
         self._job_key = None
         self._served = []
+        self._pending = []
+        self.cycle_reports = list(state.get("cycle_reports", []))
         if self.workdir is None and state.get("workdir"):
             self.workdir = Path(state["workdir"])
-
-    def report(self) -> dict[str, Any]:
-        """For summary.json: the mesh and the jobs' mean time profile (s)."""
-        return {"fe3d": {"elements": int(self._mesh0.elements.shape[0]),
-                         "h_fine_m": self._mesh0.h_fine, "size_factor": self.size_factor,
-                         "profile": self.profile()}}
