@@ -322,3 +322,31 @@ def test_deck_split_cycles(tmp_path: Path) -> None:
                if ln.startswith(f"{ref}, 1, 1,")]
     assert [float(t) for t in targets[2:]] == [5e-6, 0.0, -5e-6, 0.0] * 2
     assert f"{1e-5 * P0:.9e}" in deck  # tension at large clearances
+
+
+@needs_ccx
+def test_job_cache_serves_the_same_job_without_running_ccx(tmp_path: Path) -> None:
+    """Two solvers on the same case and a shared ``cache``: the first runs ccx and stores the
+    job, the second copies it (``cached``, no ccx time) and serves bitwise the same fields;
+    a changed case (another load) is a different deck and runs."""
+    def solve(load: float, name: str):  # noqa: ANN202
+        s = FEContactSolver(load=load * WINDOW, window=WINDOW, n=64, amplitude=AMPLITUDE,
+                            n_increments=4, h_over_a=0.5, size_factor=20, threads=1,
+                            timeout=600, workdir=tmp_path / name, cache=tmp_path / "cache")
+        s.reset()
+        loaded = s.solve_increment(0.0)
+        s.begin_cycle()
+        return s, [loaded] + [s.solve_increment(float(o)) for o in s.offsets]
+
+    first, a = solve(LOAD, "first")
+    second, b = solve(LOAD, "second")
+    third, _ = solve(0.8 * LOAD, "third")
+    assert [j.cached for j in first.jobs + second.jobs + third.jobs] == [False, True, False]
+    assert second.jobs[0].seconds_ccx == 0.0
+    for x, y in zip(a, b, strict=True):
+        np.testing.assert_array_equal(x.pressure, y.pressure)
+        np.testing.assert_array_equal(x.traction, y.traction)
+        np.testing.assert_array_equal(x.slip, y.slip)
+    rows = (tmp_path / "second" / "jobs.csv").read_text().splitlines()
+    assert rows[0].split(",")[-2:] == ["cached", "deck"] and rows[1].split(",")[-2] == "1"
+    assert len(list((tmp_path / "cache").iterdir())) == 2  # two decks, no temporary left

@@ -310,6 +310,9 @@ class FEConfig(_Model):
     timeout: float = Field(1800.0, gt=0, description="wall-clock limit of one ccx job, s")
     retries: int = Field(1, ge=0, le=4, description="retries after a non-convergence, each "
                          "with half the largest increment")
+    cache: str | None = Field(None, description="folder of finished ccx jobs keyed by the "
+                              "deck's bytes and the ccx build: a deck found there is not run "
+                              "again (the chapter 6 study shares one across its stages)")
 
 
 class FrettingConfig(_Model):
@@ -791,7 +794,7 @@ def _jsonable(cfg: FrettingConfig) -> dict[str, Any]:
 
 #: Config fields a resumed run may change: ``cycles`` (raised, to extend a run) and the
 #: ``[output]`` table (what is written, not the numbers).
-RESUME_MAY_CHANGE = ("cycles", "output.", "fe.threads", "fe.timeout")
+RESUME_MAY_CHANGE = ("cycles", "output.", "fe.threads", "fe.timeout", "fe.cache")
 
 
 def check_resume(cfg: FrettingConfig, meta: dict[str, Any], path: Path) -> None:

@@ -219,6 +219,7 @@ class FEContactSolver(CcxJobs, FirstBodySolver):
         threads: int = 1,
         timeout: float = 900.0,
         retries: int = 1,
+        cache: str | Path | None = None,
         workdir: str | Path | None = None,
         executable: str = "ccx",
         stress_depth: float | None = None,
@@ -309,6 +310,8 @@ class FEContactSolver(CcxJobs, FirstBodySolver):
         if int(retries) != retries or retries < 0:
             raise ValueError(f"retries = {retries!r} is not allowed: an integer >= 0")
         self.retries = int(retries)
+        #: folder of finished ccx jobs keyed by deck (:func:`.jobs.run_job`; None: no cache)
+        self.cache: Path | None = None if cache is None else Path(cache)
         self.workdir: Path | None = None if workdir is None else Path(workdir)
         #: node-to-surface contact, the pair declared once (docs/fe.md, "Reversals": ccx
         #: 2.20's surface-to-surface friction loses 30-40 % of mu P on the return strokes)
@@ -500,12 +503,13 @@ class FEContactSolver(CcxJobs, FirstBodySolver):
                               fine_stress=False, stress_sets=("LCOL", "UCOL"))
 
         run, refine, t_deck, t_ccx = run_job(write, self.retries, self.threads, self.timeout,
-                                             self.executable)
+                                             self.executable, self.cache)
         t_mesh += t_deck
         t3 = time.perf_counter()
         res = read_results(run.job, mesh)
         t_read = time.perf_counter() - t3
         rec = JobRecord(cycle=self._cycle + 1, folder=folder, deck=run.job.with_suffix(".inp"),
+                        cached=run.cached,
                         elements=mesh.n_elements, refine=refine * base, seconds_mesh=t_mesh,
                         seconds_ccx=t_ccx, seconds_read=t_read, cycles=int(cycles),
                         worn_volume_upper=self.worn_volume("upper", mesh),

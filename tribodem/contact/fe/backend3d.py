@@ -305,6 +305,7 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         threads: int = 1,
         timeout: float = 1800.0,
         retries: int = 1,
+        cache: str | Path | None = None,
         workdir: str | Path | None = None,
         executable: str = "ccx",
         stress_depth: float | None = None,
@@ -398,6 +399,8 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         if int(retries) != retries or retries < 0:
             raise ValueError(f"retries = {retries!r} is not allowed: an integer >= 0")
         self.retries = int(retries)
+        #: folder of finished ccx jobs keyed by deck (:func:`.jobs.run_job`; None: no cache)
+        self.cache: Path | None = None if cache is None else Path(cache)
         self.workdir: Path | None = None if workdir is None else Path(workdir)
         self.stress_depth = (_check_positive("stress_depth", stress_depth)
                              if stress_depth is not None else 4.5 * a)
@@ -692,13 +695,14 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         t_mesh = time.perf_counter() - t0
         run, refine, t_deck, t_ccx = run_job(
             lambda refine, name: self.write_deck(folder / f"{name}.inp", mesh, seat, refine),
-            self.retries, self.threads, self.timeout, self.executable)
+            self.retries, self.threads, self.timeout, self.executable, self.cache)
         t_mesh += t_deck
         t3 = time.perf_counter()
         blocks = read_dat(run.dat)
         states = self._read(blocks, mesh)
         t_read = time.perf_counter() - t3
         rec = JobRecord(cycle=self._cycle + 1, folder=folder, deck=run.job.with_suffix(".inp"),
+                        cached=run.cached,
                           elements=int(mesh.elements.shape[0]), refine=refine,
                           seconds_mesh=t_mesh, seconds_ccx=t_ccx, seconds_read=t_read,
                           worn_volume_upper=self.worn_volume("upper", mesh),

@@ -66,6 +66,7 @@ class CcxRun:
     job: Path  #: ``<folder>/<name>`` without suffix
     seconds: float  #: wall-clock time of the ccx process, s
     log: str  #: ccx's standard output and error
+    cached: bool = False  #: the results were copied from a job cache (no ccx process run)
 
     @property
     def dat(self) -> Path:

@@ -8,7 +8,9 @@ increments in order, and the stop when a criterion asks for stresses deeper than
 from __future__ import annotations
 
 import csv
+import hashlib
 import json
+import shutil
 import tempfile
 import time
 from collections.abc import Callable
@@ -39,30 +41,83 @@ class JobRecord:
     cycles: int = 1  #: cycles after the loading in the job (chained mode: > 1)
     worn_volume_upper: float = 0.0  #: worn volume of the morphed upper body, m^3
     worn_volume_lower: float = 0.0  #: worn volume of the morphed lower body, m^3
+    cached: bool = False  #: ccx's results came from the job cache (not run again)
 
 
 JOB_COLUMNS = ("cycle", "cycles", "elements", "refine", "seconds_mesh", "seconds_ccx",
                "seconds_read", "seconds_map", "worn_volume_upper_m3", "worn_volume_lower_m3",
-               "deck")
+               "cached", "deck")
+
+
+#: the ccx outputs a job cache keeps (and copies back on a hit)
+CACHED_SUFFIXES = (".dat", ".frd", ".sta", ".cvg", ".log")
+
+
+def _cache_key(deck: Path, executable: str | None) -> str:
+    """The deck's bytes and the ccx executable (path, size, mtime): equal keys, equal
+    results (ccx is deterministic for a given deck and build)."""
+    h = hashlib.sha256(deck.read_bytes())
+    exe = shutil.which(executable or "ccx")
+    if exe:
+        st = Path(exe).stat()
+        h.update(f"{exe}|{st.st_size}|{st.st_mtime_ns}".encode())
+    return h.hexdigest()[:32]
+
+
+def _from_cache(deck: Path, cache: Path, key: str) -> CcxRun | None:
+    entry = cache / key
+    if not (entry / "job.dat").exists():
+        return None
+    job = deck.with_suffix("")
+    for suffix in CACHED_SUFFIXES:
+        if (entry / f"job{suffix}").exists():
+            shutil.copyfile(entry / f"job{suffix}", job.with_suffix(suffix))
+    return CcxRun(job=job, seconds=0.0, log=job.with_suffix(".log").read_text(errors="replace"),
+                  cached=True)
+
+
+def _to_cache(run: CcxRun, cache: Path, key: str) -> None:
+    """Copy a finished job's outputs into ``cache/key`` (a temporary folder renamed into
+    place: a reader never sees half an entry; a concurrent writer's entry is kept)."""
+    cache.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(prefix=f".{key}-", dir=cache))
+    for suffix in CACHED_SUFFIXES:
+        src = run.job.with_suffix(suffix)
+        if src.exists():
+            shutil.copyfile(src, tmp / f"job{suffix}")
+    try:
+        tmp.rename(cache / key)
+    except OSError:  # another process stored it first
+        shutil.rmtree(tmp, ignore_errors=True)
 
 
 def run_job(write: Callable[[int, str], Path], retries: int, threads: int, timeout: float,
-            executable: str | None) -> tuple[CcxRun, int, float, float]:
+            executable: str | None, cache: Path | None = None
+            ) -> tuple[CcxRun, int, float, float]:
     """Write and run one ccx job, retrying a non-converging one with increments refined
     2, 4, ... times (``retries`` more attempts; the last failure is raised).
 
     ``write(refine, name)`` writes the deck ``name`` (``job``, ``job_refine2``, ...) at that
-    refinement and returns its path. Returns (the run, its refinement, seconds writing decks,
-    seconds in ccx over all attempts)."""
+    refinement and returns its path. ``cache``: a folder of finished jobs keyed by the deck's
+    bytes and the ccx build; a deck found there is not run again, its outputs are copied
+    into the job folder (``CcxRun.cached``). Returns (the run, its refinement, seconds
+    writing decks, seconds in ccx over all attempts)."""
     t_deck = t_ccx = 0.0
     for attempt in range(retries + 1):
         refine = 2**attempt
         t1 = time.perf_counter()
         deck = write(refine, "job" if attempt == 0 else f"job_refine{refine}")
         t_deck += time.perf_counter() - t1
+        key = _cache_key(deck, executable) if cache is not None else ""
+        if cache is not None:
+            hit = _from_cache(deck, cache, key)
+            if hit is not None:
+                return hit, refine, t_deck, t_ccx
         t2 = time.perf_counter()
         try:
             run = run_ccx(deck, threads=threads, timeout=timeout, executable=executable)
+            if cache is not None:
+                _to_cache(run, cache, key)
         except CcxConvergenceError:
             t_ccx += time.perf_counter() - t2
             if attempt == retries:
@@ -177,7 +232,8 @@ class CcxJobs:
                     self._prior_jobs = rows[1:]
         rows = [[rec.cycle, rec.cycles, rec.elements, rec.refine, f"{rec.seconds_mesh:.4f}",
                  f"{rec.seconds_ccx:.3f}", f"{rec.seconds_read:.4f}", f"{rec.seconds_map:.4f}",
-                 f"{rec.worn_volume_upper:.9e}", f"{rec.worn_volume_lower:.9e}", str(rec.deck)]
+                 f"{rec.worn_volume_upper:.9e}", f"{rec.worn_volume_lower:.9e}",
+                 int(rec.cached), str(rec.deck)]
                 for rec in self.jobs]
         write_csv(path, JOB_COLUMNS, self._prior_jobs + rows)
 
