@@ -58,7 +58,6 @@ from tribodem.contact.base import (
     IncrementResult,
     Recession,
     SubsurfaceStress,
-    Unsupported,
     WindowTooSmallError,
     _check_positive,
     contact_modulus,
@@ -69,7 +68,7 @@ from tribodem.contact.fe.ccx import (
     FESolverStopped,
     find_ccx,
 )
-from tribodem.contact.fe.deck import FEMaterial, LoadCase, sliding_contact, write_deck
+from tribodem.contact.fe.deck import LoadCase, sliding_contact, write_deck
 from tribodem.contact.fe.jobs import CcxJobs, JobRecord, check_stress_depth, run_job
 from tribodem.contact.fe.mesh import Mesh, PadOnFlat, cylinder_on_flat, hertz_line, morph_columns
 from tribodem.contact.fe.mesh import worn_area as mesh_worn_area
@@ -86,8 +85,6 @@ FRETTING_H_OVER_A = 0.25
 #: modes of :class:`FEContactSolver`: ``fresh`` (one job per cycle, virgin bodies: the
 #: seed's way) and ``chained`` (cycles continue in one job while the geometry is unchanged)
 MODES = ("fresh", "chained")
-#: materials of :class:`FEContactSolver`: elastic, or bilinear elastic-plastic (``*PLASTIC``)
-MATERIALS = ("elastic", "elastic-plastic")
 #: plastic runs: the smallest number of cycle increments ccx may take per cycle, and the
 #: load increments (docs/fe.md, "Elastic-plastic cycles": >= 32 cycle increments converge
 #: where 16 stalled; the sliding set-up's 10 E/h penalty is the one measured there)
@@ -244,26 +241,13 @@ class FEContactSolver(CcxJobs, FirstBodySolver):
                              "line contact only (2D plane strain); allowed: 'line'")
         if mode not in MODES:
             raise ValueError(f"mode = {mode!r} is not allowed: allowed: {', '.join(MODES)}")
-        if material not in MATERIALS:
-            raise ValueError(f"material = {material!r} is not allowed: allowed: "
-                             f"{', '.join(MATERIALS)}")
         if int(chain_cycles) != chain_cycles or chain_cycles < 1:
             raise ValueError(f"chain_cycles = {chain_cycles!r} is not allowed: an integer >= 1")
         self.mode = mode
-        self.material = material
-        self.plastic = material == "elastic-plastic"
         self.chain_cycles = int(chain_cycles)
-        if int(plastic_increments) != plastic_increments or plastic_increments < 4:
-            raise ValueError(f"plastic_increments = {plastic_increments!r} is not allowed: "
-                             "an integer >= 4")
-        self.plastic_increments = int(plastic_increments)
+        self._set_material(material, plastic_increments, yield_strength, uts, uts_strain,
+                           hardening)
         self.capabilities = self.capabilities_for({"material": material, "mode": mode})
-        self.plastic_law = FEMaterial(
-            yield_strength=_check_positive("yield_strength", yield_strength),
-            uts=_check_positive("uts", uts), uts_strain=_check_positive("uts_strain", uts_strain),
-            hardening=hardening)
-        if self.plastic:
-            self.plastic_law.plastic_table()  # ValueError on an impossible law
         self.executable = find_ccx(executable)  # CcxNotFoundError names the install command
         self.upper, self.lower = upper, lower
         self._base_upper, self._base_lower = upper, lower
@@ -350,14 +334,6 @@ class FEContactSolver(CcxJobs, FirstBodySolver):
     def hertz(self) -> tuple[float, float]:
         """Hertz (p0 Pa, a m) of the unworn line contact (Johnson eq 4.45)."""
         return hertz_line(self.load_per_length, self.radius, self.modulus)
-
-    def _materials(self) -> tuple[FEMaterial, FEMaterial]:
-        lo, up = self.lower_material, self.upper_material
-        law = self.plastic_law
-        y = law.yield_strength if self.plastic else None
-        return tuple(FEMaterial(b.young, b.poisson, yield_strength=y, uts=law.uts,  # type: ignore[return-value]
-                                uts_strain=law.uts_strain, hardening=law.hardening)
-                     for b in (lo, up))
 
     @property
     def plastic_depth(self) -> float:
@@ -793,14 +769,6 @@ class FEContactSolver(CcxJobs, FirstBodySolver):
                 self._peeq_cache[key] = (total / count)[:, None]
         return self._peeq_cache[key]
 
-    def _plastic_grid_x(self, body: str) -> NDArray[np.float64]:
-        """x of the plastic-step grid: the window (upper, its own frame) or the window plus
-        the stroke (lower, lab frame) at the window spacing, m."""
-        if body == "upper":
-            return self.coords
-        pad = math.ceil(self.amplitude / self.dx) + 1
-        return (np.arange(-pad, self.n + pad) - self.n // 2) * self.dx
-
     def _plastic_step(self, t: float, prev_t: float | None) -> list[PlasticStep]:
         """The plastic step ending at total time ``t`` from ``prev_t`` (None: from the
         virgin state), one per body, on [33, nx, 2] grids (constant along the cylinder's
@@ -823,17 +791,6 @@ class FEContactSolver(CcxJobs, FirstBodySolver):
                                      dp=np.repeat(dp[:, :, None], 2, axis=2),
                                      stress=np.repeat(stress[:, :, None, :], 2, axis=2)))
         return steps
-
-    def plastic_steps(self) -> list[PlasticStep]:
-        """The plastic steps solved since the last call (then forgotten): every output
-        increment of the loading (a job's first cycle) and of the cycles served, one step
-        per body (:attr:`PlasticStep.body`: the upper body's grid in its window frame, the
-        lower body's in the lab frame over the window plus the stroke)."""
-        if not self.plastic:
-            raise Unsupported("the fe solver gives plastic strain with material = "
-                              "'elastic-plastic'")
-        out, self._pending = self._pending, []
-        return out
 
     # -- what a cycle measured -------------------------------------------------------------
     def _cycle_report(self, pos: int, incs: list[IncrementResult]) -> dict[str, Any]:

@@ -58,7 +58,6 @@ from tribodem.contact.base import (
     IncrementResult,
     Recession,
     SubsurfaceStress,
-    Unsupported,
     WindowTooSmallError,
     _check_positive,
     contact_modulus,
@@ -66,7 +65,6 @@ from tribodem.contact.base import (
 )
 from tribodem.contact.elastoplastic import PlasticStep
 from tribodem.contact.fe.backend import (
-    MATERIALS,
     PLASTIC_LOAD_INCREMENTS,
     PLASTIC_MIN_INCREMENTS,
     cell_average,
@@ -87,7 +85,6 @@ from tribodem.contact.fe.crossed import (
 )
 from tribodem.contact.fe.deck import (
     ContactSettings,
-    FEMaterial,
     _fmt,
     _time_points,
     _write_ids,
@@ -330,22 +327,9 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         if mode not in MODES:
             raise ValueError(f"mode = {mode!r} is not allowed for the fe3d backend: allowed: "
                              f"{', '.join(MODES)}")
-        if material not in MATERIALS:
-            raise ValueError(f"material = {material!r} is not allowed: allowed: "
-                             f"{', '.join(MATERIALS)}")
-        self.material = material
-        self.plastic = material == "elastic-plastic"
-        if int(plastic_increments) != plastic_increments or plastic_increments < 4:
-            raise ValueError(f"plastic_increments = {plastic_increments!r} is not allowed: "
-                             "an integer >= 4")
-        self.plastic_increments = int(plastic_increments)
+        self._set_material(material, plastic_increments, yield_strength, uts, uts_strain,
+                           hardening)
         self.capabilities = self.capabilities_for({"material": material})
-        self.plastic_law = FEMaterial(
-            yield_strength=_check_positive("yield_strength", yield_strength),
-            uts=_check_positive("uts", uts), uts_strain=_check_positive("uts_strain", uts_strain),
-            hardening=hardening)
-        if self.plastic:
-            self.plastic_law.plastic_table()  # ValueError on an impossible law
         self.mode = mode
         self.executable = find_ccx(executable)
         self.upper, self.lower = upper, lower
@@ -551,14 +535,6 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         below = _bilinear(self._xl, self._ys, z_lo, up[..., 0][inside], up[..., 1][inside])
         gap = up[..., 2][inside] - below
         return float(gap.min()) + 0.05 * a * a / self.radius
-
-    def _materials(self) -> tuple[FEMaterial, FEMaterial]:
-        lo, up = self.lower_material, self.upper_material
-        law = self.plastic_law
-        y = law.yield_strength if self.plastic else None
-        return tuple(FEMaterial(b.young, b.poisson, yield_strength=y, uts=law.uts,  # type: ignore[return-value]
-                                uts_strain=law.uts_strain, hardening=law.hardening)
-                     for b in (lo, up))
 
     @property
     def plastic_depth(self) -> float:
@@ -988,14 +964,6 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         z_surf = _bilinear(xs, ys, z_top, np.array([xyz[0]]), np.array([abs(xyz[1])]))[0, 0]
         return float(pe[e, g]), float(abs(xyz[2] - z_surf))
 
-    def _plastic_grid_x(self, body: str) -> NDArray[np.float64]:
-        """x of the plastic-step grid: the window (upper, its own frame) or the window plus
-        the stroke (lower, lab frame) at the window spacing, m."""
-        if body == "upper":
-            return self.coords
-        pad = math.ceil(self.amplitude / self.dx) + 1
-        return (np.arange(-pad, self.n + pad) - self.n // 2) * self.dx
-
     def _plastic_steps_of_job(self) -> list[PlasticStep]:
         """The job's plastic steps, one per body per output increment: the loading (from the
         virgin state to the load) and each increment of the cycle, on [17, nx, n] grids
@@ -1019,16 +987,6 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
                                          dp=dp, stress=stress))
             prev = t
         return steps
-
-    def plastic_steps(self) -> list[PlasticStep]:
-        """The plastic steps solved since the last call (then forgotten): the loading and
-        every output increment of the cycle of the last job, one step per body
-        (:attr:`PlasticStep.body`)."""
-        if not self.plastic:
-            raise Unsupported("the fe3d solver gives plastic strain with material = "
-                              "'elastic-plastic'")
-        out, self._pending = self._pending, []
-        return out
 
     # -- what a cycle measured -------------------------------------------------------------
     def _cycle_report(self) -> dict[str, Any]:

@@ -10,6 +10,7 @@ from __future__ import annotations
 import csv
 import hashlib
 import json
+import math
 import shutil
 import tempfile
 import time
@@ -20,8 +21,10 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from tribodem.contact.base import IncrementResult
+from tribodem.contact.base import ElasticBody, IncrementResult, Unsupported, _check_positive
+from tribodem.contact.elastoplastic import PlasticStep
 from tribodem.contact.fe.ccx import CcxConvergenceError, CcxRun, FESolverStopped, run_ccx
+from tribodem.contact.fe.deck import FEMaterial
 from tribodem.io.results import write_csv
 
 
@@ -47,6 +50,10 @@ class JobRecord:
 JOB_COLUMNS = ("cycle", "cycles", "elements", "refine", "seconds_mesh", "seconds_ccx",
                "seconds_read", "seconds_map", "worn_volume_upper_m3", "worn_volume_lower_m3",
                "cached", "deck")
+
+
+#: materials of the ccx backends: elastic, or bilinear elastic-plastic (``*PLASTIC``)
+MATERIALS = ("elastic", "elastic-plastic")
 
 
 #: the ccx outputs a job cache keeps (and copies back on a hit)
@@ -153,6 +160,62 @@ class CcxJobs:
     _k: int | None
     _served: list[IncrementResult]
     _prior_jobs: list[list[str]] | None = None
+
+    upper_material: ElasticBody
+    lower_material: ElasticBody
+    coords: NDArray[np.float64]
+    dx: float
+    n: int
+    _pending: list[PlasticStep]
+
+    def _set_material(self, material: str, plastic_increments: int, yield_strength: float,
+                      uts: float, uts_strain: float, hardening: float | None) -> None:
+        """Check and keep the bodies' material (:data:`MATERIALS`) and plastic law (Pa, Pa,
+        -, Pa; ``ValueError`` on an impossible one) and the fewest ccx increments per
+        plastic cycle."""
+        if material not in MATERIALS:
+            raise ValueError(f"material = {material!r} is not allowed: allowed: "
+                             f"{', '.join(MATERIALS)}")
+        self.material = material
+        self.plastic = material == "elastic-plastic"
+        if int(plastic_increments) != plastic_increments or plastic_increments < 4:
+            raise ValueError(f"plastic_increments = {plastic_increments!r} is not allowed: "
+                             "an integer >= 4")
+        self.plastic_increments = int(plastic_increments)
+        self.plastic_law = FEMaterial(
+            yield_strength=_check_positive("yield_strength", yield_strength),
+            uts=_check_positive("uts", uts), uts_strain=_check_positive("uts_strain", uts_strain),
+            hardening=hardening)
+        if self.plastic:
+            self.plastic_law.plastic_table()  # ValueError on an impossible law
+
+    def _materials(self) -> tuple[FEMaterial, FEMaterial]:
+        """The (lower, upper) ccx materials: elastic constants, with the plastic law."""
+        lo, up = self.lower_material, self.upper_material
+        law = self.plastic_law
+        y = law.yield_strength if self.plastic else None
+        return tuple(FEMaterial(b.young, b.poisson, yield_strength=y, uts=law.uts,  # type: ignore[return-value]
+                                uts_strain=law.uts_strain, hardening=law.hardening)
+                     for b in (lo, up))
+
+    def _plastic_grid_x(self, body: str) -> NDArray[np.float64]:
+        """x of the plastic-step grid: the window (upper, its own frame) or the window plus
+        the stroke (lower, lab frame) at the window spacing, m."""
+        if body == "upper":
+            return self.coords
+        pad = math.ceil(self.amplitude / self.dx) + 1
+        return (np.arange(-pad, self.n + pad) - self.n // 2) * self.dx
+
+    def plastic_steps(self) -> list[PlasticStep]:
+        """The plastic steps solved since the last call (then forgotten): the loading (a
+        job's first cycle) and every output increment of the cycles served, one step per
+        body (:attr:`PlasticStep.body`: the upper body's grid in its window frame, the lower
+        body's in the lab frame over the window plus the stroke)."""
+        if not self.plastic:
+            raise Unsupported(f"the {self.name} solver gives plastic strain with material = "
+                              "'elastic-plastic'")
+        out, self._pending = self._pending, []
+        return out
 
     def _folder(self) -> Path:
         """This cycle's job folder (a temporary work folder if none was given)."""
