@@ -15,12 +15,12 @@ and the checkpoint; an instability exits 3 after writing the rows so far and a s
 ``status = "stopped"``.
 
 A sweep runs each (condition, packing) member as an independent task on Dask
-(``tribodem.braking.ensemble``: a local cluster of one-thread worker processes, or
-``--scheduler``), each in its own folder; re-running the same sweep skips members whose
-summary.json is finished with the same config, resumes the others from their checkpoints
-and starts over those whose config changed. Ctrl-C stops the members, closes the cluster
-and exits 130; a failed member is reported (comparison.md, stderr) and the comparison
-covers the others (exit 3).
+(``tribodem.braking.ensemble`` on ``tribodem.io.ensemble``: a local cluster of one-thread
+worker processes, or ``--scheduler``), each in its own folder; re-running the same sweep
+skips members whose summary.json is finished with the same config, resumes the others from
+their checkpoints and starts over those whose config changed. Ctrl-C stops the members,
+closes the cluster and exits 130; a failed member is reported (comparison.md, stderr) and
+the comparison covers the others (exit 3).
 """
 
 from __future__ import annotations
@@ -388,8 +388,9 @@ def braking_sweep(
     mid-member: the scheduler reschedules the member, which resumes from its checkpoint. A
     failed member is reported and left out of the comparison (exit 3 at the end)."""
     from tribodem.braking.compare import write_comparison
-    from tribodem.braking.ensemble import check_scheduler, member_plan, run_members
+    from tribodem.braking.ensemble import member_plan
     from tribodem.io import runs
+    from tribodem.io.ensemble import check_scheduler, run_members
     from tribodem.io.runs import RunStopped
 
     if seeds is not None:
@@ -432,7 +433,8 @@ def braking_sweep(
         try:
             done, failed, where = run_members(
                 todo, len(members), len(results), scheduler=scheduler, workers=workers,
-                progress=progress, echo=lambda s: typer.echo(s, err=True))
+                progress=progress, echo=lambda s: typer.echo(s, err=True),
+                desc="braking sweep")
         except BaseException:
             typer.echo("\nsweep stopped: finished members are kept; run the same command "
                        "again to skip them and resume the others from their checkpoints",

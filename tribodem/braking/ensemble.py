@@ -1,54 +1,36 @@
-"""Sweep ensembles on Dask: every (condition, packing) member is one independent task.
+"""Braking sweep members on Dask: every (condition, packing) member is one independent task.
 
-``tribodem braking sweep --packings N`` runs its 5 x N members on ``dask.distributed``:
-
-- by default on a ``LocalCluster`` of worker *processes* with one thread each (``--workers``,
-  default all local cores), every worker with numba limited to one thread
-  (``NUMBA_NUM_THREADS=1`` in its environment and ``numba.set_num_threads(1)`` in the task),
-  so N members run at once on N cores without oversubscription;
-- with ``--scheduler tcp://HOST:PORT`` (or a scheduler JSON file) on an existing cluster
-  (``dask scheduler`` / ``dask worker``, dask-jobqueue, Kubernetes). The output folder must
-  then be on a file system every worker shares with the client.
+``tribodem braking sweep --packings N`` runs its 5 x N members with the ensemble machinery of
+:mod:`tribodem.io.ensemble` (a local cluster of one-thread worker processes, or
+``--scheduler tcp://HOST:PORT``; members done / running / failed; a failed member reported,
+not fatal; Ctrl-C stops the members and closes the cluster). This module says what a
+braking member is (:class:`Member`) and what its task does.
 
 **A member is idempotent and retry-safe** (:func:`run_member`): the task itself looks at its
-folder when it starts, on whichever worker, and returns the finished summary found there,
-resumes from ``checkpoint.npz`` (bitwise the uninterrupted run) or starts over. Every file
-it writes is written atomically (``tribodem.io.results``), so a worker killed at any moment
-leaves either the old or the new version of each file; the scheduler reschedules the task
-of a lost worker (``distributed.scheduler.allowed-failures``, default 3 losses per task),
-and the new attempt resumes from the last checkpoint. Two attempts of the same member
-running at once (a worker cut off from the scheduler but still alive) write the same bytes.
-
-The client side (:func:`run_members`) submits the members that are not finished, shows
-members done / running / failed, reports a failed member without stopping the others, and
-on Ctrl-C (or any error) sets the sweep's stop event (tasks on a remote cluster stop at
-their next sample after a checkpoint), cancels the futures, closes the client and the local
-cluster, and re-raises.
+folder when it starts, on whichever worker (:func:`member_plan`), and returns the finished
+summary found there, resumes from ``checkpoint.npz`` (bitwise the uninterrupted run) or
+starts over; it runs with one numba thread and stops at its next sample after a checkpoint
+when the sweep's stop event is set. Every file it writes is written atomically
+(``tribodem.io.results``), so a worker killed at any moment leaves either the old or the new
+version of each file, and a rescheduled attempt resumes from the last checkpoint. Two
+attempts of the same member running at once (a worker cut off from the scheduler but still
+alive) write the same bytes.
 """
 
 from __future__ import annotations
 
-import logging
-import os
-import time
-import uuid
-from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from tribodem.io.config import ConfigError
-
-#: environment of every local worker process: one thread per numeric library
-WORKER_ENV = {"NUMBA_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1",
-              "OPENBLAS_NUM_THREADS": "1"}
-#: seconds between two looks at the sweep's stop event inside a running member
-STOP_POLL_S = 2.0
+from tribodem.io.ensemble import stop_check
 
 
 @dataclass
 class Member:
-    """One (condition, packing) run of a sweep and its folder."""
+    """One (condition, packing) run of a sweep and its folder (a
+    :class:`tribodem.io.ensemble.Member`: its task is :func:`run_member`)."""
 
     condition: int
     packing: int
@@ -62,6 +44,18 @@ class Member:
     @property
     def label(self) -> str:
         return f"condition {self.condition} packing {self.packing}"
+
+    @property
+    def task_name(self) -> str:
+        return f"braking-c{self.condition}-p{self.packing}"
+
+    @property
+    def task(self) -> Any:
+        return run_member
+
+    @property
+    def args(self) -> tuple[Any, ...]:
+        return self.data, str(self.folder.resolve())
 
 
 def member_plan(cfg_data: dict[str, Any], d: Path) -> tuple[str, Any]:
@@ -104,37 +98,6 @@ def member_plan(cfg_data: dict[str, Any], d: Path) -> tuple[str, Any]:
     return "resume", None
 
 
-class MemberStopped(RuntimeError):
-    """A member stopped because its sweep was stopped (Ctrl-C on the client)."""
-
-
-def _stop_check(event_name: str | None) -> Callable[[], bool] | None:
-    """A cheap ``should_stop()`` for a task: looks at the sweep's ``distributed.Event`` at
-    most every ``STOP_POLL_S`` seconds (None outside a worker or without an event)."""
-    if event_name is None:
-        return None
-    try:
-        from distributed import Event, get_worker
-
-        get_worker()
-        ev = Event(event_name)
-    except Exception:  # noqa: BLE001 - not on a worker: nothing to poll
-        return None
-    last = [time.monotonic()]
-
-    def should_stop() -> bool:
-        now = time.monotonic()
-        if now - last[0] < STOP_POLL_S:
-            return False
-        last[0] = now
-        try:
-            return bool(ev.is_set())
-        except Exception:  # noqa: BLE001 - scheduler unreachable: keep going
-            return False
-
-    return should_stop
-
-
 def run_member(cfg_data: dict[str, Any], out: str, stop_event: str | None = None
                ) -> dict[str, Any]:
     """The task of one member (idempotent, retry-safe): decide from the folder's state --
@@ -146,168 +109,4 @@ def run_member(cfg_data: dict[str, Any], out: str, stop_event: str | None = None
     if what == "done":
         return info
     return _run_one(cfg_data, out, 1, resume=what == "resume",
-                    should_stop=_stop_check(stop_event))
-
-
-def local_cores() -> int:
-    """Cores this process may run on."""
-    try:
-        return len(os.sched_getaffinity(0))
-    except (AttributeError, OSError):
-        return os.cpu_count() or 1
-
-
-def check_scheduler(scheduler: str) -> dict[str, str]:
-    """The ``Client`` keyword for ``--scheduler`` (an address or a scheduler file), or
-    ``ConfigError`` naming the option, the value and what is allowed."""
-    if "://" in scheduler:
-        proto, _, rest = scheduler.partition("://")
-        host, _, port = rest.rpartition(":")
-        if proto in ("tcp", "tls", "ucx", "inproc") and host and port.isdigit():
-            return {"address": scheduler}
-    elif Path(scheduler).is_file():
-        return {"scheduler_file": scheduler}
-    raise ConfigError(f"--scheduler = '{scheduler}': allowed: a scheduler address "
-                      "tcp://HOST:PORT (or tls://HOST:PORT) or an existing scheduler JSON "
-                      "file")
-
-
-def open_client(scheduler: str | None, workers: int) -> tuple[Any, Any]:
-    """(client, local cluster or None): a ``LocalCluster`` of ``workers`` processes (0 =
-    all local cores) with one thread each, or a client of the cluster at ``scheduler``
-    (``tcp://HOST:PORT``, ``tls://...`` or a scheduler JSON file); ``ConfigError`` naming
-    ``--scheduler`` when it cannot be reached within 15 s."""
-    import dask
-    from distributed import Client, LocalCluster
-
-    logging.getLogger("distributed").setLevel(logging.CRITICAL)
-    if scheduler is not None:
-        kw = check_scheduler(scheduler)
-        try:
-            return Client(timeout="15s", set_as_default=False, **kw), None
-        except (OSError, TimeoutError, ValueError) as err:
-            raise ConfigError(f"--scheduler = '{scheduler}': cannot connect ({err}); "
-                              "allowed: the address of a running dask scheduler") from None
-    n = workers or local_cores()
-    with dask.config.set({"distributed.scheduler.worker-saturation": 1.0,
-                          "distributed.worker.daemon": True}):
-        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                               dashboard_address=None, silence_logs=logging.CRITICAL,
-                               env=dict(WORKER_ENV))
-    try:
-        client = Client(cluster, set_as_default=False)
-    except BaseException:
-        cluster.close()
-        raise
-    return client, cluster
-
-
-def close(client: Any, cluster: Any) -> None:
-    """Close the client and (if ours) the local cluster, quietly."""
-    for obj in (client, cluster):
-        if obj is None:
-            continue
-        try:
-            obj.close(timeout=10)
-        except Exception:  # noqa: BLE001 - already gone
-            pass
-
-
-def _kill(pids: list[int]) -> None:
-    """SIGKILL the local worker processes (their nannies are closed with the cluster)."""
-    import signal
-
-    for pid in pids:
-        try:
-            os.kill(pid, signal.SIGKILL)
-        except OSError:
-            pass
-
-
-def _running(client: Any, keys: set[str]) -> int:
-    """Our tasks being processed on a worker, at most one per worker thread."""
-    try:
-        busy = sum(1 for ks in client.processing().values() for k in ks if k in keys)
-        return min(busy, sum(client.nthreads().values()))
-    except Exception:  # noqa: BLE001 - a display only
-        return 0
-
-
-def run_members(todo: list[Member], total: int, done_before: int, *, scheduler: str | None,
-                workers: int, progress: bool, echo: Callable[[str], None]
-                ) -> tuple[dict[tuple[int, int], dict[str, Any]], dict[tuple[int, int], str],
-                           str]:
-    """Run ``todo`` on Dask; returns (summaries by key, failure message by key, a line
-    describing the cluster). A failed member (an exception in its task, a task lost with
-    its workers too often, a folder the client cannot see) is reported through ``echo``
-    and left out; the others go on. Ctrl-C or any error: stop event set, futures
-    cancelled, client and local cluster closed, re-raised."""
-    from distributed import Event
-
-    from tribodem.io import runs
-
-    client, cluster = open_client(scheduler, workers)
-    results: dict[tuple[int, int], dict[str, Any]] = {}
-    failed: dict[tuple[int, int], str] = {}
-    tag = uuid.uuid4().hex[:8]
-    stop_name = f"tribodem-sweep-{tag}-stop"
-    futs: dict[Any, Member] = {}
-    pids: list[int] = []
-    try:
-        if cluster is not None:  # our own workers: killed at once on a stop
-            pids = list(client.run(os.getpid).values())
-        nthreads = client.nthreads()
-        where = (f"local cluster of {len(nthreads)} worker process(es) x 1 thread"
-                 if cluster is not None else
-                 f"cluster at {client.scheduler.address} ({len(nthreads)} worker(s), "
-                 f"{sum(nthreads.values())} thread(s) now)")
-        for m in todo:
-            key = f"braking-c{m.condition}-p{m.packing}-{tag}"
-            f = client.submit(run_member, m.data, str(m.folder.resolve()), stop_name,
-                              key=key, pure=False, retries=0)
-            futs[f] = m
-        keys = {f.key for f in futs}
-        pending = set(futs)
-        with runs.progress(total, "member", "braking sweep", enabled=progress,
-                           initial=done_before) as bar:
-            last = 0.0
-            while pending:
-                finished = {f for f in pending if f.done()}
-                pending -= finished
-                if not finished:
-                    time.sleep(0.25)
-                for f in finished:
-                    m = futs[f]
-                    try:
-                        s = f.result()
-                        if not (m.folder / "summary.json").is_file():
-                            raise RuntimeError(
-                                f"its summary.json is not visible from the client in "
-                                f"'{m.folder}': --out must be on a file system shared by "
-                                "the client and every worker")
-                        results[m.key] = s
-                    except Exception as err:  # noqa: BLE001 - reported, the rest go on
-                        failed[m.key] = f"{type(err).__name__}: {err}"
-                        echo(f"  {m.label}: failed: {failed[m.key]}")
-                    bar.update(1)
-                now = time.monotonic()
-                if finished or now - last > 1.0:
-                    last = now
-                    keys = {f.key for f in pending}
-                    bar.set_postfix_str(f"done {len(results) + done_before}, running "
-                                        f"{_running(client, keys)}, failed {len(failed)}")
-    except BaseException:  # Ctrl-C (or anything): stop the members now, then re-raise
-        _kill(pids)  # local workers: at once (every member file is written atomically)
-        try:
-            Event(stop_name, client=client).set()
-        except Exception:  # noqa: BLE001 - best effort
-            pass
-        try:
-            client.cancel(list(futs), force=True)
-        except Exception:  # noqa: BLE001 - best effort
-            pass
-        close(client, cluster)
-        raise
-    close(client, cluster)
-    return results, failed, where
-
+                    should_stop=stop_check(stop_event))

@@ -1090,3 +1090,36 @@ def debris_study_cmd(
                                echo=typer.echo)
     typer.echo(f"done: debris study at cycle {summary['cycle']} "
                f"({', '.join(f'{c:,}' for c in wanted)} particles) -> {out}")
+
+
+@fretting_app.command("sweep")
+def sweep_cmd(
+    table: Annotated[Path, typer.Option(
+        "--table", help="CSV table: a header of config fields in dotted form (contact.load, "
+        "wear.criterion, cycles, ...) and an optional name column; one row per member.")],
+    out: Annotated[Path, typer.Option(
+        "--out", help="Output directory (a folder per member, sweep.csv, sweep.json); "
+        "re-running the same sweep there skips finished members and resumes the others.")],
+    config: Annotated[Path | None, typer.Option(
+        "--config", help="TOML base config of every row (default: the defaults).")] = None,
+    quick: Annotated[bool, typer.Option(
+        "--quick", help="64^2 grid, 10 cycles (as fretting run --quick); the table's cells "
+        "override it.")] = False,
+    workers: Annotated[int, typer.Option(
+        "--workers", min=0, max=1024, help="Worker processes of the local Dask cluster "
+        "(1 thread each); 0 = all local cores. Not with --scheduler.")] = 0,
+    scheduler: Annotated[str | None, typer.Option(
+        "--scheduler", help="Use an existing Dask cluster: tcp://HOST:PORT of its scheduler "
+        "or its scheduler JSON file; --out must be on a file system the workers share.")
+    ] = None,
+    progress: Annotated[bool, typer.Option(
+        "--progress/--no-progress", help="Progress bar (members done / running / failed) on "
+        "stderr.")] = True,
+) -> None:
+    """A parameter study: every row of --table is a fretting run, an independent,
+    idempotent task on Dask in OUT/<name>/; writes sweep.csv and sweep.json. A failed (or
+    early-stopped) member is reported and the others go on (exit 3 at the end)."""
+    from tribodem.fretting.sweep import run_sweep
+
+    run_sweep(table, out, config, quick, workers, scheduler, progress, echo=typer.echo,
+              err_echo=lambda s: typer.echo(s, err=True))

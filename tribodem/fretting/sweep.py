@@ -1,0 +1,441 @@
+"""``tribodem fretting sweep``: a fretting parameter study over a table of configs on Dask.
+
+The table is a CSV file: a header of config fields in dotted form (``cycles``, ``solver``,
+``contact.load``, ``contact.amplitude``, ``wear.criterion``, ``jump.params.N``, ...) and an
+optional ``name`` column (the member's folder; default ``member_001``, ...); each row is a
+member, the base config (``--config``, or the defaults; ``--quick`` as in ``fretting run``)
+with the row's non-empty cells merged over it. A cell is read as a TOML value (``100``,
+``0.3e-3``, ``true``, ``[0.5, 0.3, 0.2]``, ``"text"``), else as text (``energy``).
+
+Every row is validated as a :class:`~tribodem.fretting.cli.FrettingConfig` and checked as
+``fretting run`` checks it before building the solver (criterion and solver compatible,
+window, criterion, jumping, debris), all before any work: a bad table is refused with
+``ConfigError`` naming the row, the field, the value and what is allowed (exit 2), and
+nothing is written. The solver's own checks run in the member's task (a failed member).
+
+Each member is one task of :mod:`tribodem.io.ensemble` running :func:`run_fretting` in
+``OUT/<name>/`` with one numba thread; the task is idempotent and retry-safe
+(:func:`member_plan`): a finished run of the same config is returned as it is (skipped), a
+run that stopped early with the same config is kept (its stop is reported again: a resume
+would stop at the same cycle; ``fretting run --resume --out OUT/<name>`` retries it by hand),
+a checkpoint the run may resume (:func:`~tribodem.fretting.cli.check_resume`: the same
+config, cycles raised or equal, ``[output]`` free) is resumed, anything else starts over.
+
+At the end ``OUT/sweep.csv`` (a row per member: name, the table's cells, status, final
+wear depths and volumes, cycles done, wall time, message) and ``OUT/sweep.json`` are written
+atomically. A failed or stopped member is reported and the others go on; the command then
+exits 3 (:class:`~tribodem.io.runs.RunStopped`).
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import re
+import time
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from pydantic import BaseModel
+
+from tribodem.fretting.cli import (
+    QUICK,
+    FrettingConfig,
+    _flat,
+    _jsonable,
+    build_criterion,
+    check_compatible,
+    check_jump_params,
+    check_resume,
+    check_window,
+    debris_settings,
+    run_fretting,
+)
+from tribodem.fretting.output import CHECKPOINT, read_checkpoint
+from tribodem.io import runs
+from tribodem.io.config import ConfigError, load_toml, merge, validate
+from tribodem.io.ensemble import check_scheduler, run_members
+from tribodem.io.results import write_csv, write_json
+
+#: sweep.csv / sweep.json column <- summary.json entry, in this order
+RESULT_FIELDS = {"wear_depth_upper_m": "wear_depth_upper_m",
+                 "wear_depth_lower_m": "wear_depth_lower_m",
+                 "wear_volume_upper_m3": "wear_volume_upper_m3",
+                 "wear_volume_lower_m3": "wear_volume_lower_m3",
+                 "cycles_done": "cycles", "wall_time_s": "wall_time_s"}
+#: a member name: a plain folder name
+NAME_RE = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.+=-]*")
+
+
+@dataclass
+class Member:
+    """One row of the table: its config and folder (a :class:`tribodem.io.ensemble.Member`;
+    its task is :func:`run_member`)."""
+
+    name: str
+    row: int
+    cells: dict[str, str]
+    data: dict[str, Any]
+    folder: Path
+
+    @property
+    def key(self) -> str:
+        return self.name
+
+    @property
+    def label(self) -> str:
+        return f"member '{self.name}' (row {self.row})"
+
+    @property
+    def task_name(self) -> str:
+        return f"fretting-{self.name}"
+
+    @property
+    def task(self) -> Any:
+        return run_member
+
+    @property
+    def args(self) -> tuple[Any, ...]:
+        return self.data, str(self.folder.resolve())
+
+
+# ---------------------------------------------------------------- the table
+
+def _fields(model: type[BaseModel], prefix: str = "") -> dict[str, bool]:
+    """Dotted config fields -> is a free-form table (``jump.params``)."""
+    out: dict[str, bool] = {}
+    for k, f in model.model_fields.items():
+        sub = f.annotation
+        if isinstance(sub, type) and issubclass(sub, BaseModel):
+            out |= _fields(sub, f"{prefix}{k}.")
+        else:
+            out[f"{prefix}{k}"] = sub is dict or str(sub).startswith("dict")
+    return out
+
+
+def check_column(col: str, table: Path) -> None:
+    """Refuse a header name that is not a config field (naming it and what is allowed)."""
+    fields = _fields(FrettingConfig)
+    if col in fields and not fields[col]:
+        return
+    for f, free in fields.items():
+        if free and col.startswith(f + ".") and len(col) > len(f) + 1:
+            return
+    head, _, _ = col.partition(".")
+    tables = sorted({f.split(".")[0] for f in fields if "." in f})
+    if head in tables and "." in col:
+        allowed = ", ".join(f + (".<name>" if free else "") for f, free in fields.items()
+                            if f.startswith(head + "."))
+    elif head in tables:
+        allowed = f"a field of [{head}] such as {next(f for f in fields if f.startswith(head))}"
+    else:
+        top = [f for f in fields if "." not in f]
+        allowed = (f"name, {', '.join(top)} or a dotted field of "
+                   f"{', '.join(f'[{t}]' for t in tables)} (e.g. contact.load)")
+    raise ConfigError(f"--table = '{table}': column '{col}' is not a config field; "
+                      f"allowed: {allowed}")
+
+
+def parse_cell(text: str) -> Any:
+    """A cell as a TOML value (number, boolean, array, quoted string), else as text."""
+    try:
+        return tomllib.loads(f"v = {text}")["v"]
+    except tomllib.TOMLDecodeError:
+        return text
+
+
+def _nest(dotted: dict[str, Any]) -> dict[str, Any]:
+    out: dict[str, Any] = {}
+    for k, v in dotted.items():
+        d = out
+        *heads, last = k.split(".")
+        for h in heads:
+            d = d.setdefault(h, {})
+        d[last] = v
+    return out
+
+
+def read_table(table: Path) -> tuple[list[str], list[tuple[int, int, str, dict[str, str]]]]:
+    """(config columns, rows as (row number, line, name, cells)) of the CSV ``table``;
+    ``ConfigError`` for anything that is not a usable table."""
+    field = f"--table = '{table}'"
+    if table.is_dir():
+        raise ConfigError(f"{field}: is a folder; allowed: a CSV file")
+    if not table.is_file():
+        raise ConfigError(f"{field}: file does not exist")
+    try:
+        text = table.read_text(encoding="utf-8-sig")
+    except (OSError, UnicodeDecodeError) as err:
+        raise ConfigError(f"{field}: cannot be read: {err}") from None
+    try:
+        lines = [(i, r) for i, r in enumerate(csv.reader(text.splitlines()), start=1)
+                 if any(c.strip() for c in r)]
+    except csv.Error as err:
+        raise ConfigError(f"{field}: not a CSV table: {err}") from None
+    if not lines:
+        raise ConfigError(f"{field}: is empty; allowed: a header of config fields (e.g. "
+                          "name,contact.load,wear.criterion) and one row per member")
+    header = [c.strip() for c in lines[0][1]]
+    for i, col in enumerate(header):
+        if not col:
+            raise ConfigError(f"{field}: column {i + 1} of the header has no name; allowed: "
+                              "a config field in dotted form (e.g. contact.load) or name")
+        if header.count(col) > 1:
+            raise ConfigError(f"{field}: column '{col}' appears {header.count(col)} times; "
+                              "allowed: each field once")
+        if col != "name":
+            check_column(col, table)
+    if len(lines) == 1:
+        raise ConfigError(f"{field}: has a header but no rows; allowed: one row per member")
+    rows = []
+    names: dict[str, int] = {}
+    for n, (line, r) in enumerate(lines[1:], start=1):
+        if len(r) != len(header):
+            raise ConfigError(f"{field}: row {n} (line {line}) has {len(r)} cells but the "
+                              f"header {len(header)}; allowed: one cell per column (empty: "
+                              "the base config's value)")
+        cells = {c: v.strip() for c, v in zip(header, r, strict=True)}
+        name = cells.pop("name", "") or f"member_{n:03d}"
+        if not NAME_RE.fullmatch(name):
+            raise ConfigError(f"{field}: row {n} (line {line}): name = {name!r}: not a "
+                              "folder name; allowed: letters, digits, _ . + = - (not "
+                              "starting with . or -)")
+        if name in ("sweep.csv", "sweep.json"):
+            raise ConfigError(f"{field}: row {n} (line {line}): name = {name!r} is the "
+                              "sweep's own output file; allowed: another name")
+        if name in names:
+            raise ConfigError(f"{field}: row {n} (line {line}): name = {name!r} is also "
+                              f"row {names[name]}'s; allowed: a distinct name per row")
+        names[name] = n
+        rows.append((n, line, name, cells))
+    return [c for c in header if c != "name"], rows
+
+
+def base_data(config: Path | None, quick: bool) -> dict[str, Any]:
+    """The unresolved base config of every row, as ``fretting run`` builds it: defaults <-
+    ``--config`` (height maps relative to it) <- ``--quick``; checked on its own."""
+    from tribodem.fretting.cli import resolve_config
+
+    resolve_config(config, quick=quick)  # a bad base is named as the config file's
+    data: dict[str, Any] = load_toml(config) if config is not None else {}
+    contact = data.get("contact")
+    if config is not None and isinstance(contact, dict):
+        for key in ("upper_map", "lower_map"):
+            v = contact.get(key)
+            if isinstance(v, str) and not Path(v).expanduser().is_absolute():
+                contact[key] = str(Path(config).parent / v)
+    if quick:
+        data = merge(data, QUICK) if config is not None else merge(QUICK, data)
+    return data
+
+
+def preflight(cfg: FrettingConfig) -> None:
+    """The checks ``fretting run`` makes before its solver is built (``ConfigError``)."""
+    from tribodem.cyclejump import make_strategy
+
+    check_compatible(cfg)
+    check_window(cfg)
+    build_criterion(cfg)
+    if cfg.jump.strategy != "none":
+        check_jump_params(cfg.jump.strategy, cfg.jump.params)
+        try:
+            make_strategy(cfg.jump.strategy, **cfg.jump.params)
+        except (TypeError, ValueError) as err:
+            raise ConfigError(f"jump.params for '{cfg.jump.strategy}': {err}") from None
+    if cfg.debris.every is not None:
+        debris_settings(cfg)
+    if cfg.solver in ("fe", "fe3d"):
+        runs.check_threads(cfg.fe.threads, "fe.threads")
+
+
+def members(table: Path, out: Path, config: Path | None, quick: bool
+            ) -> tuple[list[str], list[Member]]:
+    """The table's columns and members, every row checked before anything is made."""
+    columns, rows = read_table(table)
+    base = base_data(config, quick)
+    result = []
+    for n, line, name, cells in rows:
+        where = f"--table '{table}' row {n} (line {line}, name '{name}')"
+        values = {}
+        for col, text in cells.items():
+            if text == "":
+                continue
+            v = parse_cell(text)
+            if col.endswith(("upper_map", "lower_map")) and isinstance(v, str) and \
+                    not Path(v).expanduser().is_absolute():
+                v = str(table.parent / v)  # relative to the table, as maps to a config
+            values[col] = v
+        cfg = validate(FrettingConfig, merge(base, _nest(values)), source=where)
+        try:
+            preflight(cfg)
+        except ConfigError as err:
+            raise ConfigError(f"{where}: {err}") from None
+        result.append(Member(name, n, cells, _jsonable(cfg), out / name))
+    return columns, result
+
+
+# ---------------------------------------------------------------- a member's task
+
+def _summary(d: Path) -> dict[str, Any] | None:
+    try:
+        s = json.loads((d / "summary.json").read_text())
+    except (OSError, ValueError):
+        return None
+    return s if isinstance(s, dict) else None
+
+
+def status_of(summary: dict[str, Any]) -> str:
+    """done (finished) or stopped (an early stop: ``stopped`` says why)."""
+    return "stopped" if summary.get("stopped") else "done"
+
+
+def member_plan(cfg_data: dict[str, Any], d: Path) -> tuple[str, Any]:
+    """What a member needs: ("done", summary) when ``d`` holds its finished run with the
+    same config, ("stopped", summary) when it holds its run stopped early with the same
+    config, ("resume", None) when it holds a checkpoint this config may resume, else
+    ("new", why-not-reused or None)."""
+    cfg = validate(FrettingConfig, cfg_data, source=f"member '{d}'")
+    new = _jsonable(cfg)
+    s = _summary(d)
+    if s is not None and s.get("config") == new:
+        if s.get("stopped"):
+            return "stopped", s
+        if s.get("cycles") == cfg.cycles:
+            return "done", s
+    ck = d / CHECKPOINT
+    if ck.is_file():
+        try:
+            meta, _ = read_checkpoint(ck)
+            check_resume(cfg, meta, ck)
+            return "resume", None
+        except ConfigError:
+            pass
+    old = (s or {}).get("config")
+    if old is None and (d / "config.toml").is_file():
+        try:
+            old = load_toml(d / "config.toml")
+        except ConfigError:
+            return "new", "its config.toml cannot be read"
+    if old is None:
+        return "new", None
+    a, b = _flat(old), _flat(new)
+    diff = [k for k in sorted(set(a) | set(b)) if a.get(k) != b.get(k)]
+    if not diff:
+        return "new", "its run did not finish and left no usable checkpoint"
+    k = diff[0]
+    more = f" (and {len(diff) - 1} more)" if len(diff) > 1 else ""
+    return "new", f"{k} changed from {a.get(k)!r} to {b.get(k)!r}{more}"
+
+
+def run_member(cfg_data: dict[str, Any], out: str, stop_event: str | None = None
+               ) -> dict[str, Any]:
+    """The task of one member (idempotent, retry-safe): decide from the folder's state
+    (:func:`member_plan`), then run ``run_fretting`` with one numba thread. Returns the
+    summary (an early stop's too: its ``stopped`` says why).
+
+    ``stop_event`` is accepted for :func:`tribodem.io.ensemble.run_members`, but
+    ``run_fretting`` has no stop hook: on an external cluster a member already running when
+    the sweep is stopped runs to its end (local workers are killed at once)."""
+    import numba
+
+    numba.set_num_threads(1)
+    d = Path(out)
+    cfg = validate(FrettingConfig, cfg_data, source=f"member '{d}'")
+    what, info = member_plan(cfg_data, d)
+    if what in ("done", "stopped"):
+        return info
+    if what == "new":  # never leave an older run's results as this one's
+        for name in ("summary.json", "results.csv", "criterion.csv"):
+            (d / name).unlink(missing_ok=True)
+    try:
+        return run_fretting(cfg, d, resume=what == "resume")
+    except runs.RunStopped:
+        s = _summary(d)
+        if s is None or not s.get("stopped"):
+            raise
+        return s
+
+
+# ---------------------------------------------------------------- the sweep
+
+def run_sweep(table: Path, out: Path, config: Path | None, quick: bool, workers: int,
+              scheduler: str | None, progress: bool, echo: Any, err_echo: Any
+              ) -> dict[str, Any]:
+    """The whole command: check everything, run the members not finished, write
+    sweep.csv / sweep.json; raise ``RunStopped`` when a member failed or stopped."""
+    if scheduler is not None and workers:
+        raise ConfigError(f"fretting sweep: --workers = {workers}: sets the local cluster's "
+                          "size, so it cannot go with --scheduler (the cluster there has "
+                          "its own workers); allowed: one of the two")
+    if scheduler is not None:
+        check_scheduler(scheduler)
+    t0 = time.perf_counter()
+    columns, todo_all = members(table, out, config, quick)
+    runs.check_out_dir(out, "--out")  # every member checked first: no folder for a bad one
+    for m in todo_all:
+        runs.check_out_dir(m.folder, f"--out member '{m.name}'")
+    runs.announce(out)
+    results: dict[str, dict[str, Any]] = {}
+    todo = []
+    for m in todo_all:
+        what, info = member_plan(m.data, m.folder)
+        if what == "done":
+            results[m.name] = info
+            echo(f"  {m.name}: finished earlier, skipped")
+        elif what == "stopped":
+            results[m.name] = info
+            echo(f"  {m.name}: stopped earlier ({info['stopped']}), kept (a resume would "
+                 f"stop again; to retry: tribodem fretting run --resume --out "
+                 f"{m.folder})")
+        else:
+            if what == "resume":
+                echo(f"  {m.name}: resuming from its checkpoint")
+            elif info:
+                echo(f"  {m.name}: starting over ({info})")
+            todo.append(m)
+    failed: dict[str, str] = {}
+    where = "nothing to run"
+    if todo:
+        try:
+            done, failed_k, where = run_members(
+                todo, len(todo_all), len(results), scheduler=scheduler, workers=workers,
+                progress=progress, echo=err_echo, desc="fretting sweep")
+        except BaseException:
+            err_echo("\nsweep stopped: finished members are kept; run the same command "
+                     "again to skip them and resume the others from their checkpoints")
+            raise
+        results.update({str(k): v for k, v in done.items()})
+        failed = {str(k): v for k, v in failed_k.items()}
+    wall = time.perf_counter() - t0
+    records = []
+    for m in todo_all:
+        s = results.get(m.name)
+        status = "failed" if s is None else status_of(s)
+        msg = failed.get(m.name, "") if s is None else (s.get("stopped") or "")
+        records.append({"name": m.name, "row": m.row, "cells": m.cells, "status": status,
+                        **{k: (s or {}).get(v) for k, v in RESULT_FIELDS.items()},
+                        "message": msg,
+                        "folder": str(m.folder)})
+    header = ["name", *columns, "status", *RESULT_FIELDS, "message"]
+    write_csv(out / "sweep.csv", header,
+              [[r["name"], *(r["cells"][c] for c in columns), r["status"],
+                *("" if r[k] is None else r[k] for k in RESULT_FIELDS), r["message"]]
+               for r in records])
+    counts = {k: sum(r["status"] == k for r in records) for k in ("done", "stopped", "failed")}
+    report = {"table": str(table), "config": None if config is None else str(config),
+              "quick": quick, "cluster": where, "wall_time_s": wall,
+              "members": len(records), "run": len(todo),
+              "skipped": len(todo_all) - len(todo), **counts, "results": records}
+    write_json(out / "sweep.json", report)
+    echo(f"sweep: {len(records)} member(s) in {wall:.1f} s on {where} ({len(todo)} run, "
+         f"{report['skipped']} skipped as finished or stopped, {counts['failed']} failed, "
+         f"{counts['stopped']} stopped) -> {out / 'sweep.csv'}")
+    if counts["failed"] or counts["stopped"]:
+        bad = next(r for r in records if r["status"] != "done")
+        raise runs.RunStopped(
+            f"{counts['failed']} of {len(records)} sweep members failed and "
+            f"{counts['stopped']} stopped early (first: {bad['name']}: {bad['status']}: "
+            f"{bad['message']}); sweep.csv covers every member")
+    return report
