@@ -303,6 +303,11 @@ def test_fe_usage_errors_exit_2(tmp_path: Path) -> None:
                      "--no-progress")
     assert r.returncode == 2 and "fe.mode" in r.stderr and "chained" in r.stderr
     assert "Traceback" not in r.stderr
+    cfg.write_text(CONFIG.replace("[fe]\n", "[fe]\nsize_factor = 6\n"))  # fe3d's range
+    r = run_tribodem("fretting", "run", "--config", str(cfg), "--out", str(tmp_path / "c"),
+                     "--no-progress")
+    assert r.returncode == 2 and "size_factor = 6" in r.stderr and ">= 10" in r.stderr
+    assert "Traceback" not in r.stderr and not (tmp_path / "c").exists()
 
 
 def test_deck_split_cycles(tmp_path: Path) -> None:

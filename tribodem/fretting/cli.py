@@ -305,7 +305,9 @@ class FEConfig(_Model):
     h_over_a: float = Field(0.25, gt=0, le=1, description="element size at the contact / "
                             "Hertz half-width (docs/fe.md: a/4 is 4x faster than a/8 at "
                             "large strokes)")
-    size_factor: float = Field(40.0, ge=10, le=200, description="bodies' size / half-width")
+    size_factor: float = Field(40.0, ge=2, le=200, description="bodies' size / contact "
+                               "half-width or radius (fe: >= 10; fe3d: its default 8, at "
+                               "most R / (2 a))")
     threads: int = Field(1, ge=0, description="ccx threads (0 = all cores; --threads)")
     timeout: float = Field(1800.0, gt=0, description="wall-clock limit of one ccx job, s")
     retries: int = Field(1, ge=0, le=4, description="retries after a non-convergence, each "

@@ -287,6 +287,9 @@ class FEContactSolver(CcxJobs, FirstBodySolver):
         self.n_increments = int(n_increments)
         self.h_over_a = _check_positive("h_over_a", h_over_a)
         self.size_factor = _check_positive("size_factor", size_factor)
+        if self.size_factor < 10.0:
+            raise ValueError(f"size_factor = {size_factor!r} is not allowed: the plane-strain "
+                             "bodies must be at least 10 half-widths (allowed: >= 10)")
         if int(threads) != threads or threads < 1:
             raise ValueError(f"threads = {threads!r} is not allowed: an integer >= 1")
         self.threads = int(threads)
