@@ -124,6 +124,14 @@ _STRESS_MIRROR = np.array([1.0, 1.0, 1.0, -1.0, 1.0, -1.0])
 _ONE = np.ones(1)
 
 
+def _projected_area(v: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Area (m^2) of quadrilateral faces [m, 4 nodes, 3] projected on the x-y plane (half
+    the cross product of the diagonals): the z component of a pressure's force is p times
+    it."""
+    d1, d2 = v[:, 2, :2] - v[:, 0, :2], v[:, 3, :2] - v[:, 1, :2]
+    return 0.5 * np.abs(d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0])
+
+
 def _voigt(s: NDArray[np.float64], body: str) -> NDArray[np.float64]:
     """ccx-order stress [..., 6] (lab frame, z up) to the contract's frame (z = depth into
     ``body``: xz and yz flip under the lower body), Voigt xx, yy, zz, yz, xz, xy."""
@@ -254,7 +262,7 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
     name = "fe3d"
     #: the class's widest capabilities; an instance's are :meth:`capabilities_for` its
     #: ``material`` (fresh mode only: plastic strain of one cycle at a time)
-    capabilities = Capabilities(plastic=True, partial_slip=True, subsurface=True,
+    capabilities = Capabilities(plastic=True, partial_slip=True, subsurface=True, debris=True,
                                 contacts=("point",))
 
     @classmethod
@@ -263,7 +271,7 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         (a fresh job starts every cycle from virgin bodies: the 2D backend's ``chained`` mode
         is not built in 3D)."""
         plastic = options.get("material", "elastic") == "elastic-plastic"
-        return Capabilities(plastic=plastic, partial_slip=True, subsurface=True,
+        return Capabilities(plastic=plastic, partial_slip=True, subsurface=True, debris=True,
                             contacts=("point",))
 
     @classmethod
@@ -424,7 +432,7 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         self._complete = count[self._cols["upper"][..., 0]] == 0.0
         self.reset()
         self._cycle = 0
-        self._job_key: tuple[bytes, bytes] | None = None
+        self._job_key: tuple[bytes, ...] | None = None
         self._served: list[IncrementResult] = []
         self._loaded_result: IncrementResult | None = None
         self._fresh_for_cycle = False
@@ -433,6 +441,8 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         self._peeq_cache: dict[tuple[str, str, float], NDArray[np.float64]] = {}
         self._pending: list[PlasticStep] = []
         self.cycle_reports: list[dict[str, Any]] = []  #: :meth:`_cycle_report` per job
+        self._debris = np.zeros((self.n, self.n))  # prescribed debris pressure, Pa
+        self._debris_load = 0.0
         self.mesh: Mesh3D = self._mesh0  #: the (morphed) mesh of the last job
 
     # -- geometry -------------------------------------------------------------------------
@@ -621,6 +631,8 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         out.write(f"*STEP, INC=1000\n*STATIC\n{dt}, 1., {dt * 1e-4}, {dt}\n")
         out.write("*BOUNDARY, OP=NEW\n" + fixed + f"{ref}, 1, 1, 0.\n")
         out.write(f"*CLOAD\n{ref}, 3, {_fmt(-self.load / 2.0)}\n")
+        debris = self._debris_faces(mesh) if self._debris_load > 0.0 else ""
+        out.write(debris)
         out.write(outputs("TLOAD") + "*END STEP\n")
         dt = 4.0 / (self.n_increments * refine * self.cycle_refine)
         for k, target in enumerate((self.amplitude, 0.0, -self.amplitude, 0.0)):
@@ -636,6 +648,8 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
             out.write("*BOUNDARY, OP=NEW\n" + fixed + f"{ref}, 1, 1, 0.\n"
                       f"{ref}, 3, 3, {_fmt(2.0 * a * a / self.radius)}\n"
                       f"*CLOAD, OP=NEW\n{ref}, 3, 0.\n")
+            if debris:  # the debris go with the load
+                out.write(self._debris_faces(mesh, scale=0.0).replace("*DLOAD", "*DLOAD, OP=NEW"))
             out.write(outputs("TLOAD") + "*END STEP\n")
         path = Path(path)
         path.write_text(out.getvalue())
@@ -643,9 +657,115 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
 
     # -- the contract ---------------------------------------------------------------------
     def reset(self) -> None:
-        """Forget the load history: the next ``solve_increment(0.0)`` is a first loading."""
+        """Forget the load history: the next ``solve_increment(0.0)`` is a first loading
+        (a prescribed debris pressure is kept)."""
         self._k: int | None = None
         self._loaded = False
+
+    def _key(self) -> tuple[bytes, ...]:
+        """The geometry and the debris pressure a job was run with."""
+        return (*super()._key(), self._debris.tobytes())
+
+    # -- debris third body (seed 003 section 3.2.7: forces mapped back) --------------------
+    @property
+    def debris_pressure(self) -> NDArray[np.float64]:
+        """The prescribed debris pressure on the window, Pa [n, n] (zeros when none)."""
+        return self._debris
+
+    @property
+    def debris_load(self) -> float:
+        """Load carried by the debris, N."""
+        return self._debris_load
+
+    def set_debris_pressure(self, pressure: NDArray[np.float64] | None) -> None:
+        """Prescribe the debris pressure on the window (the upper body's frame at offset 0),
+        Pa [n, n] (None clears). The next job loads both contact faces with it, as a face
+        pressure at each face's centre (``*DLOAD``, applied with the normal load and kept
+        through the cycle; the lower body's at the lab position under the window at offset
+        0, where the debris phase ran): the bodies are pushed apart and the solid contact
+        carries ``load - debris_load``. Kept until cleared (``reset`` keeps it too)."""
+        n = self.n
+        if pressure is None:
+            self._debris = np.zeros((n, n))
+            self._debris_load = 0.0
+            return
+        pd = np.asarray(pressure, dtype=float)
+        if pd.shape != (n, n) or not np.all(np.isfinite(pd)) or pd.min() < 0:
+            raise ValueError(f"debris pressure: shape {pd.shape}, min {np.nanmin(pd):.3g}: "
+                             f"must be finite, >= 0 Pa, shape ({n}, {n})")
+        load = float(pd.sum() * self.dx**2)
+        if load >= self.load:
+            raise ValueError(f"debris load {load:.4g} N >= applied load {self.load:.4g} N: "
+                             "the solid-solid contact would carry nothing")
+        self._debris, self._debris_load = pd.copy(), load
+
+    def _debris_at(self, x: NDArray[np.float64], y: NDArray[np.float64]
+                   ) -> NDArray[np.float64]:
+        """The debris pressure (Pa) at window-frame points (bilinear; 0 outside)."""
+        from scipy.interpolate import RegularGridInterpolator
+
+        c = self.coords
+        f = RegularGridInterpolator((c, c), self._debris, bounds_error=False, fill_value=0.0)
+        return f(np.stack([x, y], axis=-1))
+
+    def _debris_face_loads(self, mesh: Mesh3D) -> dict[str, tuple[NDArray[np.int64],
+                                                                   NDArray[np.float64],
+                                                                   NDArray[np.int64]]]:
+        """Per contact set (upper: UCONT face 1, lower: LCONT face 2): the elements, the
+        debris pressure on each face (Pa) and the face's 4 nodes (0-based). The pressure is
+        the window's at the face's centre (bilinear; zero outside the window), scaled so that
+        the faces carry the window's debris load exactly (both halves of the model): the
+        force the debris phase mapped back is conserved."""
+        out = {}
+        for name, nodes in (("UCONT", slice(0, 4)), ("LCONT", slice(4, 8))):
+            ids = mesh.element_sets[name]
+            conn = mesh.elements[ids - 1][:, nodes]
+            centre = mesh.nodes[conn].mean(axis=1)
+            p = self._debris_at(centre[:, 0], centre[:, 1])
+            area = _projected_area(mesh.nodes[conn])
+            total = 2.0 * float((p * area).sum())
+            out[name] = (ids, p * (self._debris_load / total if total > 0 else 0.0), conn)
+        return out
+
+    def _debris_faces(self, mesh: Mesh3D, scale: float = 1.0) -> str:
+        """``*DLOAD`` of the debris pressure (times ``scale``) on the contact faces of both
+        bodies (:meth:`_debris_face_loads`)."""
+        lines = ["*DLOAD"]
+        for (ids, p, _), face in zip(self._debris_face_loads(mesh).values(), (1, 2),
+                                     strict=True):
+            lines += [f"{int(e)}, P{face}, {_fmt(scale * v)}"
+                      for e, v in zip(ids, p, strict=True) if v > 0.0]
+        return "\n".join(lines) + "\n"
+
+    def loaded_solution(self, offset: float = 0.0, debris: bool = False
+                        ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """(pressure Pa, gap m) on the window under the full load at offset 0 (the only
+        offset a fresh job loads at), without or with the prescribed debris pressure (then
+        the returned pressure is solid + debris): from the loaded state of a job on the
+        current geometry (run if the last job is not that one; the next cycle reuses it when
+        it matches). The gap is the deformed one: under each upper surface node, its height
+        minus the lower surface's at the same (x, y), both displaced."""
+        if float(offset) != 0.0:
+            raise ValueError(f"offset = {offset!r}: the fe3d loaded solution is at offset 0")
+        keep = (self._debris, self._debris_load)
+        if not debris:
+            self._debris, self._debris_load = np.zeros((self.n, self.n)), 0.0
+        try:
+            if self._key() != self._job_key or not self._served:
+                self._run_job()
+                self._fresh_for_cycle = True  # the next cycle may reuse this job
+            st = self._state_of[min(self._state_of)]  # the loaded state (total time 2)
+            assert self._loaded_result is not None
+            p = self._loaded_result.pressure.copy()
+        finally:
+            self._debris, self._debris_load = keep
+        up = self.mesh.nodes[self._cols["upper"][..., 0]] + st["u_up"]
+        lo = self.mesh.nodes[self._cols["lower"][..., 0]] + st["u_lo"]
+        z_lo = _bilinear(self._xl, self._ys, lo[..., 2][..., None],
+                         up[..., 0].ravel(), np.abs(up[..., 1]).ravel())[:, 0]
+        gap = np.maximum(up[..., 2] - z_lo.reshape(up.shape[:2]), 0.0)
+        gap_w = self._window(gap, 1.0, False)
+        return (p + self._debris if debris else p), gap_w
 
     def _start_cycle(self) -> None:
         if not (self._key() == self._job_key and self._served and self._fresh_for_cycle):
@@ -709,6 +829,13 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         ltop = self._cols["lower"][..., 0]
         n_nodes = mesh.nodes.shape[0]
         states = []
+        debris_nodes = 0.0
+        if self._debris_load > 0.0:  # the debris face loads on the upper surface nodes
+            ids, p, conn = self._debris_face_loads(mesh)["UCONT"]
+            area = _projected_area(mesh.nodes[conn])  # the z force of p on a face
+            f = np.zeros(n_nodes)
+            np.add.at(f, conn, np.repeat((p * area / 4.0)[:, None], 4, axis=1))
+            debris_nodes = np.where(self._complete, f[ubot], 0.0) / self._area
         for t in want:
             k = int(np.argmin(np.abs(times - t))) if times.size else -1
             if k < 0 or abs(times[k] - t) > 1e-6:
@@ -726,6 +853,8 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
                 r = by[("displacements", name, tk)].rows
                 u[r[:, 0].astype(np.int64)] = r[:, 1:4]
             fn = np.where(self._complete[..., None], total[ubot], 0.0) / self._area[..., None]
+            if self._debris_load > 0.0:  # the face loads are in the recovered nodal forces:
+                fn[..., 2] -= debris_nodes  # what is left is the solid contact's
             fn[0, :, 1] = 0.0  # y = 0: the symmetry plane's reaction, no contact traction
             rf = by[("total force", "LBOT", tk)].rows[0, :3]
             states.append({"time": tk, "p": fn[..., 2], "qx": fn[..., 0], "qy": fn[..., 1],
@@ -1057,6 +1186,7 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         whether the bodies were loaded, the mode and the work folder."""
         return {"cycle": self._cycle, "loaded": self._loaded, "mode": self.mode,
                 "material": self.material, "cycle_reports": list(self.cycle_reports),
+                "debris_pressure": self._debris.copy(), "debris_load": self._debris_load,
                 "workdir": None if self.workdir is None else str(self.workdir)}
 
     def load_state_dict(self, state: dict[str, Any]) -> None:
@@ -1074,5 +1204,8 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         self._served = []
         self._pending = []
         self.cycle_reports = list(state.get("cycle_reports", []))
+        if "debris_pressure" in state:
+            self._debris = np.array(state["debris_pressure"], dtype=float)
+            self._debris_load = float(state["debris_load"])
         if self.workdir is None and state.get("workdir"):
             self.workdir = Path(state["workdir"])

@@ -238,7 +238,7 @@ class CcxJobs:
         """The first loading's increment, running the loading's job if it is not run."""
         raise NotImplementedError
 
-    def _key(self) -> tuple[bytes, bytes]:
+    def _key(self) -> tuple[bytes, ...]:
         """The geometry a job was run on: the column wear of both bodies."""
         wu, wl = self.column_wear()
         return wu.tobytes(), wl.tobytes()
