@@ -336,3 +336,26 @@ def test_debris_pressure_pushes_the_bodies_apart_and_is_conserved(tmp_path: Path
     np.testing.assert_array_equal(other.debris_pressure, pd)
     with pytest.raises(ValueError, match="debris load"):
         s.set_debris_pressure(pd * 6.0)
+
+
+def test_primed_mode_serves_the_steady_loop(tmp_path: Path) -> None:
+    """Mode ``primed`` (a continuous test): cycle 1 is the fresh cycle from virgin bodies,
+    dissipating Cattaneo-Mindlin's 4 mu P (A - delta*); from cycle 2 each job first runs the
+    previous cycle's second half, and the served cycle dissipates the steady
+    Mindlin-Deresiewicz loop 4 mu P (A - 0.8 delta*), 8.6 % more at A = 10 um, delta* =
+    3 mu P (2 - nu) / (8 G a). Both within 2 % (measured -0.53 % and -0.51 % at h = a/2)."""
+    s = _solver(tmp_path, h_over_a=0.5, mode="primed")
+    g = 240e9 / (2 * 1.3)
+    d_star = 3 * 0.6 * LOAD * (2 - 0.3) / (8 * g * A)
+    s.reset()
+    s.solve_increment(0.0)
+    energy = []
+    for _ in range(2):
+        s.begin_cycle()
+        incs = [s.solve_increment(float(o)) for o in s.offsets]
+        energy.append(sum(float(i.energy_density.sum()) for i in incs) * s.dx**2)
+    assert len(s.jobs) == 2  # the loading's job served cycle 1; cycle 2 ran a primed one
+    assert energy[0] == pytest.approx(4 * 0.6 * LOAD * (AMPLITUDE - d_star), rel=0.02)
+    assert energy[1] == pytest.approx(4 * 0.6 * LOAD * (AMPLITUDE - 0.8 * d_star), rel=0.02)
+    assert "*STEP" in s.jobs[1].deck.read_text() and \
+        s.jobs[1].deck.read_text().count("*STEP") == s.jobs[0].deck.read_text().count("*STEP") + 2

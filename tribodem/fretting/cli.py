@@ -290,10 +290,12 @@ class OutputConfig(_Model):
 class FEConfig(_Model):
     """``solver = "fe"``: the CalculiX plane-strain backend (docs/fe.md)."""
 
-    mode: Literal["fresh", "chained"] = Field(
+    mode: Literal["fresh", "chained", "primed"] = Field(
         "fresh", description="fresh: one ccx job per cycle on the worn geometry, virgin "
-        "material (seed 003 section 3.3); chained: cycles continue in one job while the "
-        "geometry is unchanged, so plastic strain and residual stress carry over")
+        "material (seed 003 section 3.3); chained (fe): cycles continue in one job while the "
+        "geometry is unchanged, so plastic strain and residual stress carry over; primed "
+        "(fe3d): each job from cycle 2 first runs the previous cycle's second half, so the "
+        "served cycle is a continuous test's (the steady loop of elastic bodies)")
     material: Literal["elastic", "elastic-plastic"] = Field(
         "elastic", description="elastic-plastic: bilinear isotropic hardening of the "
         "[plastic] table (seed table 5.1) in both bodies")

@@ -17,6 +17,14 @@ quarter** and **node-to-surface** contact declared once in the model data
 surface-to-surface friction is wrong on return strokes once the slide crosses elements,
 docs/fe.md "Reversals").
 
+Mode ``primed`` (a continuous fretting test): the same fresh job per cycle, but from the
+second cycle on the job runs the previous cycle's second half (0 -> -A -> 0) after the
+loading and before the served cycle, so the served cycle starts with the tangential history
+a continuous test has there; for elastic bodies that is the steady Mindlin-Deresiewicz loop
+4 mu P (A - 0.8 delta*) per cycle instead of the fresh cycle's 4 mu P (A - delta*)
+(docs/fe3d.md "fe3d vs half-space"). It costs two more quarters per job. Plastic strain is
+primed by that half cycle only (not accumulated over the run).
+
 Worn geometry (seed eqs 3.7-3.8): the worn depth of each body at each node column (i, j) is
 its recession (from :meth:`set_surfaces`) minus the unworn one (the constructor's), at the
 column's (x, y) (upper: its own frame, over the window; lower: lab frame, over the window plus
@@ -108,7 +116,7 @@ FRETTING3D_GROWTH = 1.4
 PENALTY_FACTOR = 10.0
 
 #: modes of :class:`FE3DContactSolver` (``chained`` is the 2D backend's only)
-MODES = ("fresh",)
+MODES = ("fresh", "primed")
 
 #: trilinear shape functions of the C3D8 nodes at its 2x2x2 Gauss points, [8 gp, 8 nodes];
 #: its inverse extrapolates Gauss-point values to the nodes
@@ -635,7 +643,10 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         out.write(debris)
         out.write(outputs("TLOAD") + "*END STEP\n")
         dt = 4.0 / (self.n_increments * refine * self.cycle_refine)
-        for k, target in enumerate((self.amplitude, 0.0, -self.amplitude, 0.0)):
+        targets = (self.amplitude, 0.0, -self.amplitude, 0.0)
+        if self._primed():  # the previous cycle's second half: a continuous test's history
+            targets = (-self.amplitude, 0.0) + targets
+        for k, target in enumerate(targets):
             out.write(f"*STEP, INC=10000\n*STATIC\n{dt}, 1., {dt * 1e-4}, {dt}\n")
             if k == 0:
                 out.write(friction(s.mu, s.stick_factor))
@@ -663,8 +674,12 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         self._loaded = False
 
     def _key(self) -> tuple[bytes, ...]:
-        """The geometry and the debris pressure a job was run with."""
-        return (*super()._key(), self._debris.tobytes())
+        """The geometry, the debris pressure and the priming a job was run with."""
+        return (*super()._key(), self._debris.tobytes(), b"primed" if self._primed() else b"")
+
+    def _primed(self) -> bool:
+        """Whether the next job primes its cycle (mode ``primed``, from the second cycle)."""
+        return self.mode == "primed" and self._cycle >= 1
 
     # -- debris third body (seed 003 section 3.2.7: forces mapped back) --------------------
     @property
@@ -821,7 +836,9 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         """Per output time of the loaded state and the cycle: total time, forces on the
         upper body (N, both halves), nodal tractions on the upper surface (Pa, [ny, nx]:
         p, qx, qy), the displacements of both contact faces ([ny, nx, 3], m) and of REF."""
-        want = np.concatenate([[2.0], 2.0 + 4.0 * np.arange(1, self.n_increments + 1)
+        start = 4.0 if self._primed() else 2.0  # the served cycle's start (total time)
+        want = np.concatenate([[2.0], [start] if start > 2.0 else [],
+                               start + 4.0 * np.arange(1, self.n_increments + 1)
                                / self.n_increments])
         by = {(b.kind, b.set_name, round(b.time, 9)): b for b in blocks}
         times = np.array(sorted({round(b.time, 9) for b in blocks if b.kind == "total force"}))
@@ -872,7 +889,12 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         return self._pt_x @ full.T @ self._pt_y.T
 
     def _serve(self, states: list[dict[str, Any]]) -> None:
-        """Map the job's surface fields to the window: the loaded state and the increments."""
+        """Map the job's surface fields to the window: the loaded state and the increments
+        (a primed job's states: the loaded state, the served cycle's start, its increments;
+        the start is the first increment's reference only)."""
+        cycle_start = states[1] if len(states) == self.n_increments + 2 else None
+        if cycle_start is not None:
+            states = [states[0], *states[2:]]
         n, cell = self.n, self.dx * self.dx
         xs, xl, ys_full = self._xs, self._xl, self._ys_full
         k_t = self.settings.stick_factor * self.settings.penalty_factor * min(
@@ -881,6 +903,8 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         xg, yg = np.meshgrid(xs, self._ys)  # [ny, nx] undeformed upper surface nodes
         prev: dict[str, Any] | None = None
         for j, st in enumerate(states):
+            if j == 1 and cycle_start is not None:
+                prev = cycle_start
             p_node = np.where(st["p"] > 1e-5 * st["p"].max(), st["p"], 0.0)
             on = p_node > 0.0
             p = self._window(p_node, 1.0, True)
