@@ -302,6 +302,22 @@ class FirstBodySolver(ABC):
         raise Unsupported(f"{type(self).__name__} cannot restore a state")
 
 
+def checked_debris_pressure(pressure: NDArray[np.float64], n: int, dx: float, load: float
+                            ) -> tuple[NDArray[np.float64], float]:
+    """(a copy of ``pressure``, its load N) for ``set_debris_pressure``: finite, >= 0 Pa, on
+    the n x n window of spacing ``dx`` (m), carrying less than the applied ``load`` (N);
+    ``ValueError`` saying what is wrong otherwise."""
+    pd = np.asarray(pressure, dtype=float)
+    if pd.shape != (n, n) or not np.all(np.isfinite(pd)) or pd.min() < 0:
+        raise ValueError(f"debris pressure: shape {pd.shape}, min {np.nanmin(pd):.3g}: "
+                         f"must be finite, >= 0 Pa, shape ({n}, {n})")
+    debris_load = float(pd.sum() * dx**2)
+    if debris_load >= load:
+        raise ValueError(f"debris load {debris_load:.4g} N >= applied load {load:.4g} N: "
+                         "the solid-solid contact would carry nothing")
+    return pd.copy(), debris_load
+
+
 def require(solver: FirstBodySolver, needs: frozenset[str] | set[str], who: str) -> None:
     """Refuse (``ValueError`` naming ``who``, the backend and what is missing) a solver that
     lacks a capability in ``needs``."""

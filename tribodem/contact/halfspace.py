@@ -53,6 +53,7 @@ from tribodem.contact.base import (
     SubsurfaceStress,
     WindowTooSmallError,
     _check_positive,
+    checked_debris_pressure,
     contact_modulus,
     dundurs_beta,
 )
@@ -301,15 +302,8 @@ class HalfSpaceSolver(FirstBodySolver):
         if self.contact == "line":
             raise ValueError("a debris pressure is not available for a line contact (its "
                              "displacement here is the non-periodic point-contact integral)")
-        pd = np.asarray(pressure, dtype=float)
-        if pd.shape != (n, n) or not np.all(np.isfinite(pd)) or pd.min() < 0:
-            raise ValueError(f"debris pressure: shape {pd.shape}, min {np.nanmin(pd):.3g}: "
-                             f"must be finite, >= 0 Pa, shape ({n}, {n})")
-        load = float(pd.sum() * self.dx**2)
-        if load >= self.load:
-            raise ValueError(f"debris load {load:.4g} N >= applied load {self.load:.4g} N: "
-                             "the solid-solid contact would carry nothing")
-        self._debris_pressure, self._debris_load = pd.copy(), load
+        pd, self._debris_load = checked_debris_pressure(pressure, n, self.dx, self.load)
+        self._debris_pressure = pd
         u = fftconvolve(pd, self._kernel, mode="full")[n - 1 : 2 * n - 1, n - 1 : 2 * n - 1]
         self._debris_u = u / (math.pi * self.modulus)
 

@@ -68,6 +68,7 @@ from tribodem.contact.base import (
     SubsurfaceStress,
     WindowTooSmallError,
     _check_positive,
+    checked_debris_pressure,
     contact_modulus,
     cycle_offsets,
 )
@@ -704,15 +705,8 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
             self._debris = np.zeros((n, n))
             self._debris_load = 0.0
             return
-        pd = np.asarray(pressure, dtype=float)
-        if pd.shape != (n, n) or not np.all(np.isfinite(pd)) or pd.min() < 0:
-            raise ValueError(f"debris pressure: shape {pd.shape}, min {np.nanmin(pd):.3g}: "
-                             f"must be finite, >= 0 Pa, shape ({n}, {n})")
-        load = float(pd.sum() * self.dx**2)
-        if load >= self.load:
-            raise ValueError(f"debris load {load:.4g} N >= applied load {self.load:.4g} N: "
-                             "the solid-solid contact would carry nothing")
-        self._debris, self._debris_load = pd.copy(), load
+        self._debris, self._debris_load = checked_debris_pressure(pressure, n, self.dx,
+                                                                  self.load)
 
     def _debris_at(self, x: NDArray[np.float64], y: NDArray[np.float64]
                    ) -> NDArray[np.float64]:
