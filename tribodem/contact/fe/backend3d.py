@@ -661,7 +661,7 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
                       f"{ref}, 3, 3, {_fmt(2.0 * a * a / self.radius)}\n"
                       f"*CLOAD, OP=NEW\n{ref}, 3, 0.\n")
             if debris:  # the debris go with the load
-                out.write(self._debris_faces(mesh, scale=0.0).replace("*DLOAD", "*DLOAD, OP=NEW"))
+                out.write(self._debris_faces(mesh, scale=0.0, header="*DLOAD, OP=NEW"))
             out.write(outputs("TLOAD") + "*END STEP\n")
         path = Path(path)
         path.write_text(out.getvalue())
@@ -736,10 +736,11 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
             out[name] = (ids, p * (self._debris_load / total if total > 0 else 0.0), conn)
         return out
 
-    def _debris_faces(self, mesh: Mesh3D, scale: float = 1.0) -> str:
-        """``*DLOAD`` of the debris pressure (times ``scale``) on the contact faces of both
-        bodies (:meth:`_debris_face_loads`)."""
-        lines = ["*DLOAD"]
+    def _debris_faces(self, mesh: Mesh3D, scale: float = 1.0, header: str = "*DLOAD") -> str:
+        """``header`` (``*DLOAD``, or ``*DLOAD, OP=NEW`` to replace the step's loads) and the
+        debris pressure (times ``scale``) on the contact faces of both bodies
+        (:meth:`_debris_face_loads`)."""
+        lines = [header]
         for (ids, p, _), face in zip(self._debris_face_loads(mesh).values(), (1, 2),
                                      strict=True):
             lines += [f"{int(e)}, P{face}, {_fmt(scale * v)}"
@@ -807,11 +808,10 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         states = self._read(blocks, mesh)
         t_read = time.perf_counter() - t3
         rec = JobRecord(cycle=self._cycle + 1, folder=folder, deck=run.job.with_suffix(".inp"),
-                        cached=run.cached,
-                          elements=int(mesh.elements.shape[0]), refine=refine,
-                          seconds_mesh=t_mesh, seconds_ccx=t_ccx, seconds_read=t_read,
-                          worn_volume_upper=self.worn_volume("upper", mesh),
-                          worn_volume_lower=self.worn_volume("lower", mesh))
+                        cached=run.cached, elements=int(mesh.elements.shape[0]), refine=refine,
+                        seconds_mesh=t_mesh, seconds_ccx=t_ccx, seconds_read=t_read,
+                        worn_volume_upper=self.worn_volume("upper", mesh),
+                        worn_volume_lower=self.worn_volume("lower", mesh))
         t4 = time.perf_counter()
         self.mesh = mesh
         self._blocks = blocks
@@ -886,7 +886,7 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         """Map the job's surface fields to the window: the loaded state and the increments
         (a primed job's states: the loaded state, the served cycle's start, its increments;
         the start is the first increment's reference only)."""
-        cycle_start = states[1] if len(states) == self.n_increments + 2 else None
+        cycle_start = states[1] if self._primed() else None
         if cycle_start is not None:
             states = [states[0], *states[2:]]
         n, cell = self.n, self.dx * self.dx

@@ -115,22 +115,23 @@ def run_job(write: Callable[[int, str], Path], retries: int, threads: int, timeo
         t1 = time.perf_counter()
         deck = write(refine, "job" if attempt == 0 else f"job_refine{refine}")
         t_deck += time.perf_counter() - t1
-        key = _cache_key(deck, executable) if cache is not None else ""
         if cache is not None:
+            key = _cache_key(deck, executable)
             hit = _from_cache(deck, cache, key)
             if hit is not None:
                 return hit, refine, t_deck, t_ccx
         t2 = time.perf_counter()
         try:
             run = run_ccx(deck, threads=threads, timeout=timeout, executable=executable)
-            if cache is not None:
-                _to_cache(run, cache, key)
         except CcxConvergenceError:
             t_ccx += time.perf_counter() - t2
             if attempt == retries:
                 raise
             continue
-        return run, refine, t_deck, t_ccx + time.perf_counter() - t2
+        t_ccx += time.perf_counter() - t2
+        if cache is not None:
+            _to_cache(run, cache, key)
+        return run, refine, t_deck, t_ccx
     raise AssertionError("unreachable")  # pragma: no cover
 
 
