@@ -284,6 +284,12 @@ def test_plastic_first_yield_under_the_surface(tmp_path: Path) -> None:
             assert rep[f"max_peeq_{body}"] > max(loaded, 1e-4)  # the sliding adds to it
             assert rep[f"max_peeq_depth_{body}_m"] < 0.25 * h  # at the surface Gauss point
         assert rep["max_s22_compressive_pa"] > 0.8 * factor * 1.60 * y
+        # the loaded state's peak vertical stress: p0 at the top Gauss points (0.1 a deep on
+        # axis: Hertz sigma_zz 0.99 p0), within the h = a / 2 mesh's +-15 % while elastic
+        s22_loaded = rep["max_s22_compressive_loaded_pa"]
+        assert s22_loaded <= rep["max_s22_compressive_pa"]
+        if factor < 1.0:
+            assert abs(s22_loaded / (factor * 1.60 * y) - 1.0) < 0.15, s22_loaded
         steps = solver.plastic_steps()
         assert len(steps) == 2 * (1 + len(incs))  # the loading and each increment, per body
         assert {s.body for s in steps} == {"upper", "lower"}

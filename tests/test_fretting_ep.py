@@ -112,6 +112,17 @@ def test_dfdi_failure_strain_and_column_depth():
     assert du2.max() < 1e-12 * h and crit.info()["max_dfdi_upper"] == pytest.approx(1.0)
 
 
+def test_dfdi_seed_script_reading():
+    """Appendix IV's reading: eps_f = 1.65 eps0 whatever the stress (its exponent divides by
+    the sum over all nodes); the default eps0 is the script's 0.118."""
+    crit = DFDICriterion(triaxiality="seed-script")
+    assert crit.eps0 == 0.118
+    sig = np.array([[900e6, 0, 0, 0, 0, 0], [-500e6, -500e6, -1500e6, 0, 0, 0]])
+    assert crit.failure_strain(sig) == pytest.approx([1.65 * 0.118] * 2, rel=1e-15)
+    with pytest.raises(ValueError, match="triaxiality"):
+        DFDICriterion(triaxiality="global")
+
+
 def test_dfdi_refused_by_elastic_solver():
     with pytest.raises(ValueError, match="plastic strain"):
         DFDICriterion().check_solver(HalfSpaceSolver(n=32))
@@ -178,5 +189,6 @@ def test_swt_miner_sum_gives_closed_form_cycles():
         info = crit.info()
         assert info["miner_sum_max_upper"] == pytest.approx(cycle / life, rel=1e-6)
         assert info["cycles_to_first_wear_upper"] == pytest.approx(life, rel=1e-6)
+        assert info["cycles_to_first_wear_upper_centre"] == pytest.approx(life, rel=1e-6)
         assert info["cycles_to_first_wear_lower"] == pytest.approx(life, rel=1e-6)
         assert du.max() == 0.0 and dl.max() == 0.0

@@ -41,12 +41,17 @@ def test_compare_and_ranking() -> None:
              "mean_scar_depth_per_cycle_lower_m": 1.2e-4},
             {"stage": "energy", "mean_scar_depth_per_cycle_lower_m": 1e-9},
             {"stage": "swt", "mean_scar_depth_per_cycle_lower_m": 0.0,
-             "cycles_to_first_wear_lower": 700.0},
+             "cycles_to_first_wear_lower": 700.0, "cycles_to_first_wear_upper": 929.0,
+             "cycles_to_first_wear_upper_centre": float("inf")},
             {"stage": "dfdi", "skipped": "no plastic strain"}]
     t = {(r["stage"], r["quantity"]): r for r in compare(rows)}
     assert abs(t[("von_mises", "mean_scar_depth_lower_m")]["ratio"] - 1.1) < 1e-12
     assert t[("von_mises", "mean_scar_depth_lower_m")]["within_20pct"] is True
     assert t[("dfdi", "mean_scar_depth_lower_m")]["ours"] is None
+    # the seed's "over 200 thousands" is a bound: 929 misses it, an undamaged centre meets it
+    assert t[("swt", "cycles_to_first_wear_upper")]["within_20pct"] is False
+    assert t[("swt", "cycles_to_first_wear_upper_centre")]["within_20pct"] is True
+    assert t[("swt", "cycles_to_first_wear_lower")]["within_20pct"] is True  # 700 / 600
     assert len(t) == sum(len(v) for v in SEED.values())
     assert ranking(rows) == ["von_mises", "energy", "swt"]
 

@@ -25,6 +25,7 @@ from tribodem.contact import (
     FirstBodySolver,
     contact_modulus,
 )
+from tribodem.contact.fe.backend import PLASTIC_MIN_INCREMENTS
 from tribodem.contact.fe.ccx import CcxNotFoundError
 from tribodem.contact.geometry import (
     CrossedCylinders,
@@ -226,7 +227,12 @@ class WearConfig(_Model):
     stress_depth: float | None = Field(None, gt=0, description="subsurface grid depth, m")
     stress_nz: int = Field(33, ge=2, le=257, description="subsurface grid levels")
     stress_samples: int = Field(8, ge=1, description="sampled increments per cycle")
-    eps0: float = Field(0.132, gt=0, description="dfdi: uniaxial failure strain eps0 (eq 6.2)")
+    eps0: float = Field(EN24T.dfdi_eps0, gt=0, description="dfdi: uniaxial failure strain "
+                        "eps0 (eq 6.2; default the seed's script's, appendix IV)")
+    dfdi_triaxiality: Literal["local", "seed-script"] = Field(
+        "local", description="dfdi: eq 6.2's sigma_m / sigma_eq per point (local), or as the "
+        "seed's script computes it (ranges over the cycle, sigma_eq summed over all nodes: "
+        "the exponent ~0, eps_f = 1.65 eps0)")
     swt_nz: int = Field(17, ge=2, le=129, description="swt: subsurface levels")
     swt_plane_step: float = Field(5.0, gt=0, le=90, description="swt: candidate planes, deg")
 
@@ -301,9 +307,9 @@ class FEConfig(_Model):
         "[plastic] table (seed table 5.1) in both bodies")
     chain_cycles: int = Field(5, ge=1, le=1000, description="chained mode: cycles per ccx "
                               "job (a used-up chain is run again with this many more)")
-    plastic_increments: int = Field(32, ge=4, le=10000, description="elastic-plastic: the "
-                                    "fewest ccx increments per cycle (32 converged where 16 "
-                                    "stalled, docs/fe.md)")
+    plastic_increments: int = Field(
+        PLASTIC_MIN_INCREMENTS, ge=4, le=10000, description="elastic-plastic: the fewest ccx "
+        "increments per cycle (32 converged where 16 stalled, docs/fe.md)")
     h_over_a: float = Field(0.25, gt=0, le=1, description="element size at the contact / "
                             "Hertz half-width (docs/fe.md: a/4 is 4x faster than a/8 at "
                             "large strokes)")
@@ -362,7 +368,7 @@ def build_criterion(cfg: FrettingConfig) -> Criterion:
         "s22": {"yield_strength": w.yield_strength, **stress},
         "von_mises": {"yield_strength": w.yield_strength, **stress},
         "shear": {"uts": w.uts, **stress},
-        "dfdi": {"eps0": w.eps0, "depth": w.stress_depth},
+        "dfdi": {"eps0": w.eps0, "depth": w.stress_depth, "triaxiality": w.dfdi_triaxiality},
         "swt": {"nz": w.swt_nz, "depth": w.stress_depth, "samples": w.stress_samples,
                 "plane_step": w.swt_plane_step, "young": lo.young, "poisson": lo.poisson},
     }.get(name, {})

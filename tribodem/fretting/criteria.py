@@ -492,6 +492,10 @@ def _remove_damaged(crit: Any, info: dict[str, Any]
     return du, dl
 
 
+#: readings of eq 6.2's triaxiality (:class:`DFDICriterion`)
+DFDI_TRIAXIALITY = ("local", "seed-script")
+
+
 class DFDICriterion(Criterion):
     """Ductile failure damage indicator (seed eqs 6.1-6.2), threshold DFDI >= 1.
 
@@ -500,8 +504,12 @@ class DFDICriterion(Criterion):
     sigma_m mean stress, sigma_eq von Mises, both at the end of the step). Accumulated over
     cycles per material point on a [nz, ...] grid under each body (the damaged layer moves
     up as wear removes material); wear depth by :func:`column_search` at DFDI = 1.
-    ``eps0`` default 0.132 (engineering strain at the UTS implied by seed table 6.2's
-    1000 -> 1132 MPa conversion; the seed gives no number). Needs a solver with the
+    ``eps0`` default 0.118, the seed's own script's (appendix IV; the text gives no number).
+    ``triaxiality``: ``"local"`` (eq 6.2 as written: each point's sigma_m / sigma_eq) or
+    ``"seed-script"`` (what appendix IV computes: sigma_m is the mean of the principal
+    stresses' ranges over the cycle and sigma_eq the *sum over all nodes* of the von Mises
+    ranges, so the exponent is ~0 and eps_f = 1.65 eps0 everywhere; DFDI is then the peak
+    equivalent plastic strain / (1.65 eps0)). Needs a solver with the
     ``plastic`` capability (:class:`tribodem.contact.ElastoPlasticSolver`: one plastic
     state shared by both bodies; ``fe`` with ``material = "elastic-plastic"``: one per
     body, :attr:`PlasticStep.body`).
@@ -512,12 +520,16 @@ class DFDICriterion(Criterion):
     requires = frozenset({"plastic"})
     requires_over_cycles = frozenset({"plastic_every_cycle"})
 
-    def __init__(self, eps0: float = EN24T.uts_strain, depth: float | None = None,
-                 nz: int = 33) -> None:
+    def __init__(self, eps0: float = EN24T.dfdi_eps0, depth: float | None = None,
+                 nz: int = 33, triaxiality: str = "local") -> None:
         if not (math.isfinite(eps0) and eps0 > 0):
             raise ValueError(f"eps0 = {eps0!r} is not allowed: must be > 0 (failure strain)")
+        if triaxiality not in DFDI_TRIAXIALITY:
+            raise ValueError(f"triaxiality = {triaxiality!r} is not allowed: allowed: "
+                             f"{', '.join(DFDI_TRIAXIALITY)}")
         _check_stress_grid(depth, nz)
         self.eps0 = float(eps0)
+        self.triaxiality = triaxiality
         self.depth = depth
         self.nz = int(nz)
         self._d_up: NDArray[np.float64] | None = None
@@ -527,6 +539,8 @@ class DFDICriterion(Criterion):
     def failure_strain(self, stress: NDArray[np.float64]) -> NDArray[np.float64]:
         """eps_f of eq 6.2 for Voigt stresses [..., 6] (xx, yy, zz, yz, xz, xy), -."""
         s = np.asarray(stress, dtype=float)
+        if self.triaxiality == "seed-script":  # appendix IV: the exponent's ratio is ~0
+            return np.full(s.shape[:-1], 1.65 * self.eps0)
         sm = s[..., :3].mean(-1)
         dev = s[..., :3] - sm[..., None]
         seq = np.sqrt(1.5 * (dev**2).sum(-1) + 3.0 * (s[..., 3:] ** 2).sum(-1))
@@ -588,7 +602,8 @@ class DFDICriterion(Criterion):
         return dict(self._last_info)
 
     def params(self) -> dict[str, Any]:
-        return {"eps0": self.eps0, "depth_m": self.depth, "nz": self.nz}
+        return {"eps0": self.eps0, "depth_m": self.depth, "nz": self.nz,
+                "triaxiality": self.triaxiality}
 
 
 #: Seed table 6.2 (SWT, Mitchell method): b, sigma'_f (Pa), sigma_T (Pa), eps'_f, c.
@@ -755,8 +770,13 @@ class SWTCriterion(ThresholdCriterion):
                 left = np.where(r > 0, (1.0 - d) / r, np.inf)
             return float(self.cycles_done + left.min())
 
+        # the upper body's contact centre (section 6.6: "the material at the centre of the
+        # contact zone obtained very small values"): the grid's central 2 x 2 columns
+        c = self.grid.n // 2
+        centre = (slice(None), slice(c - 1, c + 1), slice(c - 1, c + 1))
         return _remove_damaged(self, {
             "cycles_to_first_wear_upper": first_wear(self._d_up, r_up),
+            "cycles_to_first_wear_upper_centre": first_wear(self._d_up[centre], r_up[centre]),
             "cycles_to_first_wear_lower": first_wear(self._d_lo, r_lo),
             "max_damage_rate_upper": float(r_up.max()),
             "max_damage_rate_lower": float(r_lo.max()),

@@ -35,8 +35,15 @@ SEED = {
     "s22": {"mean_scar_depth_lower_m": 0.157e-3, "mean_scar_depth_upper_m": 0.102e-3,
             "max_s22_Pa": 1400e6},
     "dfdi": {"mean_scar_depth_lower_m": 0.0456e-3, "mean_scar_depth_upper_m": 0.0463e-3},
-    "swt": {"cycles_to_first_wear_lower": 600, "cycles_to_first_wear_upper": 200_000},
+    "swt": {"cycles_to_first_wear_lower": 600, "cycles_to_first_wear_upper": 200_000,
+            "cycles_to_first_wear_upper_centre": 200_000},
 }
+#: Seed numbers that are bounds, not values ("over 200 thousands of cycles are required by the
+#: upper first body", section 6.6): ours agrees when it is at least the bound. The seed's
+#: figure 6.12 puts the upper body's largest SWT at the contact edges and "very small values"
+#: at its centre, so the bound is compared both ways: the whole body and its contact centre.
+SEED_LOWER_BOUNDS = {("swt", "cycles_to_first_wear_upper"),
+                     ("swt", "cycles_to_first_wear_upper_centre")}
 #: The seed's conclusion (section 6.8): from the largest over-prediction to the largest
 #: under-prediction of the experiment; shear fits the experiment best.
 SEED_ORDER = ("s22", "von_mises", "dfdi", "shear", "energy", "swt")
@@ -88,8 +95,8 @@ def row_of(st: Stage, summary: dict[str, Any]) -> dict[str, Any]:
         "wall_time_s": summary["wall_time_s"],
     }
     row["mean_scar_depth_per_cycle_lower_m"] = row["mean_scar_depth_lower_m"] / n
-    for body in ("upper", "lower"):
-        key = f"cycles_to_first_wear_{body}"
+    for key in ("cycles_to_first_wear_upper", "cycles_to_first_wear_lower",
+                "cycles_to_first_wear_upper_centre"):
         if key in crit:
             row[key] = crit[key]
     rep = summary.get("first_body_report", {}).get("cycles", [])
@@ -112,9 +119,12 @@ def compare(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
         for q, seed in nums.items():
             ours = None if r is None or r.get("skipped") else r.get(q)
             ratio = ours / seed if ours is not None and seed and math.isfinite(ours) else None
+            bound = (stage, q) in SEED_LOWER_BOUNDS
+            if bound and ours is not None and ours == math.inf:
+                ratio = math.inf
+            agree = None if ratio is None else (ratio >= 1.0 if bound else abs(ratio - 1) <= 0.2)
             out.append({"stage": stage, "quantity": q, "seed": seed, "ours": ours,
-                        "ratio": ratio,
-                        "within_20pct": None if ratio is None else abs(ratio - 1) <= 0.2})
+                        "ratio": ratio, "seed_is_lower_bound": bound, "within_20pct": agree})
     return out
 
 
@@ -154,13 +164,15 @@ def write_markdown(out: Path, rows: list[dict[str, Any]], table: list[dict[str, 
             f" | {r['max_depth_lower_m'] * um:.4g} / {r['max_depth_upper_m'] * um:.4g} | "
             f"{r['mean_scar_depth_per_cycle_lower_m'] * um:.4g} | {swt} | "
             f"{r['wall_time_s']:.1f} |")
-    lines += ["", "| stage | quantity | seed | ours | ours / seed | within 20 % |",
+    lines += ["", "| stage | quantity | seed | ours | ours / seed | within 20 % (a bound "
+              "\"> x\": at least x) |",
               "|---|---|---|---|---|---|"]
     for t in table:
         ours = "not run" if t["ours"] is None else f"{t['ours']:.4g}"
         ratio = "" if t["ratio"] is None else f"{t['ratio']:.3g}"
         within = "" if t["within_20pct"] is None else ("yes" if t["within_20pct"] else "no")
-        lines.append(f"| {t['stage']} | {t['quantity']} | {t['seed']:.4g} | {ours} | {ratio} "
+        seed = f"> {t['seed']:.4g}" if t.get("seed_is_lower_bound") else f"{t['seed']:.4g}"
+        lines.append(f"| {t['stage']} | {t['quantity']} | {seed} | {ours} | {ratio} "
                      f"| {within} |")
     lines += ["", f"Ours, largest predicted wear per cycle first: {', '.join(order)}.",
               f"Seed (section 6.8), largest over-prediction first: {', '.join(SEED_ORDER)}; "

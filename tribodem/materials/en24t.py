@@ -3,7 +3,7 @@
 Sources, all seed 003: table 5.1 (E, nu, yield, UTS; bilinear hardening), section 5.2 (the
 Fouvry energy wear coefficient of the fretting tests), table 6.2 (Smith-Watson-Topper
 constants by Mitchell's method; its true UTS 1132 MPa = 1000 MPa x (1 + e) fixes the
-engineering strain at the UTS). SI units.
+engineering strain at the UTS), appendix IV (the DFDI script's eps0 = 0.118). SI units.
 """
 
 from __future__ import annotations
@@ -23,6 +23,8 @@ class SolidMaterial:
     uts_strain: float  #: engineering strain at the UTS
     energy_wear_coefficient: float  #: Fouvry alpha, m^3/J (eq 2.7)
     swt: dict[str, float] = field(default_factory=dict)  #: b, sigma_f (Pa), sigma_t, eps_f, c
+    #: eps0 of the ductile failure damage indicator (eq 6.2), uniaxial failure strain
+    dfdi_eps0: float = 0.0
     source: str = ""
 
 
@@ -35,5 +37,7 @@ EN24T = SolidMaterial(
     uts_strain=0.132,
     energy_wear_coefficient=1.641e-6 * 1e-9,  # 1.641e-6 mm^3/J
     swt={"b": -0.103, "sigma_f": 2349e6, "sigma_t": 1132e6, "eps_f": 1.22, "c": -0.6},
-    source="seed 003 table 5.1 (elastic-plastic), section 5.2 (alpha), table 6.2 (SWT)",
+    dfdi_eps0=0.118,  # the seed's DFDI script (appendix IV: FailE = 1.65*0.118*exp(...))
+    source="seed 003 table 5.1 (elastic-plastic), section 5.2 (alpha), table 6.2 (SWT), "
+    "appendix IV (DFDI eps0)",
 )
