@@ -36,12 +36,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
 from scipy.spatial import cKDTree
 
 from tribodem.dem import Box, Material, ParallelBonds, ParticleState, PlaneWall, Simulation
+from tribodem.dem import compiled as dem_compiled
 from tribodem.dem.state import FIX_X, FIX_Y
 from tribodem.materials.library import CU_PM, Q345B, MaterialSpec
 from tribodem.materials.specimen import compact_by_radius_scaling
@@ -244,6 +246,39 @@ def _dashpots(vel, idx, v_plate, c_n, c_t, ext_force, dv):  # pragma: no cover -
         ext_force[p, 0] -= c_t * vel[p, 0]
 
 
+class BackingStep(NamedTuple):
+    """``PadBacking``'s compiled form: its dashpots (``idx``, ``c_n``, ``c_t``), the index
+    of its wall in ``sim.walls``, the plate's full drive ``target`` (N) and ``out`` =
+    [the dashpots' reaction, N] (shared with the braking loop's compiled form)."""
+
+    idx: np.ndarray
+    wall: int
+    c_n: float
+    c_t: float
+    target: float
+    out: np.ndarray
+    dv: np.ndarray
+
+
+@dem_compiled.register(BackingStep)
+@njit(cache=True)
+def _backing_step(s, c):  # pragma: no cover - numba
+    """``PadBacking.compute`` in the engine's compiled loop (the same operations)."""
+    _dashpots(c.vel, s.idx, c.wall_vel[s.wall, 1], s.c_n, s.c_t, c.ext_force, s.dv)
+    r = s.c_n * dem_compiled.np_sum(s.dv, s.dv.shape[0])
+    s.out[0] = r
+    c.wall_par[s.wall, dem_compiled.W_TARGET] = s.target - r
+    return 0
+
+
+def wall_index(sim: Simulation, wall: PlaneWall) -> int:
+    """Index of ``wall`` (this object) in ``sim.walls``; ValueError if it is not there."""
+    for k, w in enumerate(sim.walls):
+        if w is wall:
+            return k
+    raise ValueError(f"wall '{wall.name}' is not a wall of this simulation")
+
+
 class PadBacking:
     """Non-reflecting (Lysmer-Kuhlemeyer) backing of the pad's top layer (an engine
     ``Interaction``): the rest of the pad as a semi-infinite elastic medium.
@@ -269,6 +304,7 @@ class PadBacking:
         self.reaction = 0.0  # N, the dashpots' push on the plate (+: up, against the load)
         self.c_p, self.c_s = c_p, c_s
         self._dv = np.zeros(idx.size)  # each dashpot's normal speed (m/s), reused
+        self._out = np.zeros(1)  # the compiled form's reaction (N)
 
     def compute(self, sim: Simulation) -> None:
         """Add the dashpot forces; set the plate's drive to target minus their reaction."""
@@ -278,6 +314,19 @@ class PadBacking:
                   sim.ext_force, self._dv)
         self.reaction = float(self.c_n * self._dv.sum())  # numpy's sum, as before
         self.wall.target_force = self.target - self.reaction
+
+    def compiled(self, sim: Simulation) -> BackingStep:
+        """The compiled form (``BackingStep``, see ``tribodem.dem.compiled``)."""
+        if self._dv.size != self.idx.size:
+            self._dv = np.zeros(self.idx.size)
+        self._out[0] = self.reaction
+        return BackingStep(self.idx, wall_index(sim, self.wall), float(self.c_n),
+                           float(self.c_t), float(self.target), self._out, self._dv)
+
+    def after_compiled(self, sim: Simulation, state: BackingStep) -> None:
+        """The reaction of the compiled loop's last step (the plate's drive is a wall
+        state, copied back by the engine)."""
+        self.reaction = float(state.out[0])
 
     @property
     def force(self) -> float:

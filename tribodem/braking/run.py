@@ -42,9 +42,10 @@ import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
+from numba import njit
 
 from tribodem.braking.conditions import SEED_BRAKING_TIME_S, pressure_to_load, speed_to_rpm
 from tribodem.braking.measure import Reference, force_chains, measure, reference
@@ -56,7 +57,10 @@ from tribodem.braking.model import (
     build_interface,
     plate_force,
     start_sliding,
+    wall_index,
 )
+from tribodem.dem import compiled as dem_compiled
+from tribodem.dem.engine import cross_group_sum
 from tribodem.dem.thermal import Thermal, read_curve
 from tribodem.io import runs
 from tribodem.io.config import ConfigError
@@ -110,6 +114,46 @@ class RunSetup:
     speed_ramp_s: float = 0.0
 
 
+class LoopStep(NamedTuple):
+    """``_Loop``'s compiled form once the ramps are over: its plate wall's index in
+    ``sim.walls``, the backing's reaction ``reaction`` = [N] (``BackingStep.out``) if it
+    has one (``backing``), ``acc`` = [summed plate force N, distance slid m], ``n`` =
+    [steps], ``contact`` (the look accumulators), the full target (N), the sliding speed
+    (m/s), the steps between looks, a buffer for the interface forces."""
+
+    wall: int
+    backing: bool
+    reaction: np.ndarray
+    acc: np.ndarray
+    n: np.ndarray
+    contact: np.ndarray
+    full: float
+    speed: float
+    every: int
+    buf: np.ndarray
+
+
+@dem_compiled.register(LoopStep)
+@njit(cache=True)
+def _loop_step(s, c):  # pragma: no cover - numba
+    """``_Loop.compute`` after the ramps, in the engine's compiled loop (the same
+    operations): the plate force summed, a look at the interface every ``every`` steps,
+    the distance slid."""
+    if s.backing:
+        s.acc[0] += c.wall_nf[s.wall] + s.reaction[0]
+    else:
+        s.acc[0] += c.wall_nf[s.wall]
+    if s.n[0] % s.every == 0:
+        buf = s.buf if s.buf.shape[0] >= c.pair_i.shape[0] else np.zeros(c.pair_i.shape[0])
+        load = cross_group_sum(c.pinfo, c.pair_i, c.pair_j, c.group, buf)
+        s.contact[0] += 1.0
+        s.contact[1] += 1.0 if load > 0.0 else 0.0
+        s.contact[2] += load / s.full
+    s.acc[1] += s.speed * 1.0 * c.dt
+    s.n[0] += 1
+    return 0
+
+
 class _Loop:
     """An engine interaction that averages the plate's force on the pad (N) every step --
     wall contacts plus the backing dashpots' reaction -- and carries the braking loop's own
@@ -153,6 +197,28 @@ class _Loop:
         self.n += 1
         if self.ramp_steps and self.n <= self.ramp_steps:
             self.apply()
+
+    def compiled(self, sim: Any) -> LoopStep | None:
+        """The compiled form (``LoopStep``) once the load and speed ramps are over (the
+        ramps step in Python), else ``None``."""
+        if (self.ramp_steps and self.n < self.ramp_steps) or (
+                self.speed_steps and self.n < self.speed_steps):
+            return None
+        back = self.iface.backing
+        reaction = back._out if back is not None else np.zeros(1)
+        m = sim.nl.n_pairs
+        if getattr(self, "_buf", None) is None or self._buf.shape[0] < m:
+            self._buf = np.zeros(max(m, 1))
+        return LoopStep(wall_index(sim, self.iface.wall), back is not None, reaction,
+                        np.array([self.total, self.distance]), np.array([self.n]),
+                        self.contact, float(self.full), float(self.speed), CONTACT_EVERY,
+                        self._buf)
+
+    def after_compiled(self, sim: Any, state: LoopStep) -> None:
+        """Copy back the sums and the step count of the compiled loop."""
+        self.total = float(state.acc[0])
+        self.distance = float(state.acc[1])
+        self.n = int(state.n[0])
 
     @property
     def mean(self) -> float:

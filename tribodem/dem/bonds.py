@@ -32,12 +32,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 from numba import njit, prange
 
-from tribodem.dem import neighbors
+from tribodem.dem import compiled, neighbors
 from tribodem.dem.jit import kernel, serial_run
 from tribodem.dem.space import min_image
 from tribodem.dem.state import checked_per_item
@@ -380,6 +380,58 @@ def gather_bonds(cstart, cbond, bi, mode, fbond, tbi, tbj, ext_force, ext_torque
                     ext_torque[p, k] += tbj[b, k]
 
 
+class BondStep(NamedTuple):
+    """``ParallelBonds``'s compiled form (arrays shared with it; see ``compiled``)."""
+
+    i: np.ndarray
+    j: np.ndarray
+    rb: np.ndarray
+    area: np.ndarray
+    inertia: np.ndarray
+    polar: np.ndarray
+    kn: np.ndarray
+    ks: np.ndarray
+    tensile: np.ndarray
+    cohesion: np.ndarray
+    tan_phi: np.ndarray
+    fn: np.ndarray
+    fs: np.ndarray
+    mb: np.ndarray
+    mt: np.ndarray
+    normal: np.ndarray
+    mode: np.ndarray
+    newly: np.ndarray
+    brk: np.ndarray
+    fbond: np.ndarray
+    tbi: np.ndarray
+    tbj: np.ndarray
+    dim: int
+
+
+#: ``BondStep``'s event code: bonds broke this step (logged by ``after_compiled``)
+BONDS_BROKE = 1
+_bonds_2d = bond_forces_2d.serial
+_bonds_3d = bond_forces.serial
+
+
+@compiled.register(BondStep)
+@njit(cache=True)
+def _bond_step(s, c):  # pragma: no cover - numba
+    """``ParallelBonds.compute`` on its serial build (bonds summed into ``c.ext_force`` /
+    ``c.ext_torque``); ``BONDS_BROKE`` when a bond broke."""
+    if s.dim == 2:
+        nnew = _bonds_2d(c.pos, c.vel, c.omega, c.radius, s.i, s.j, s.rb, s.area, s.inertia,
+                         s.kn, s.ks, s.tensile, s.cohesion, s.tan_phi, s.fn, s.fs, s.mb,
+                         s.normal, s.mode, s.newly, s.brk, s.fbond, s.tbi, s.tbj, c.dt,
+                         c.length, c.periodic, True, c.ext_force, c.ext_torque)
+    else:
+        nnew = _bonds_3d(c.pos, c.vel, c.omega, c.radius, s.i, s.j, s.rb, s.area, s.inertia,
+                         s.polar, s.kn, s.ks, s.tensile, s.cohesion, s.tan_phi, s.fn, s.fs,
+                         s.mb, s.mt, s.normal, s.mode, s.newly, s.brk, s.fbond, s.tbi, s.tbj,
+                         s.dim, c.dt, c.length, c.periodic, True, c.ext_force, c.ext_torque)
+    return BONDS_BROKE if nnew else 0
+
+
 def bond_csr(bi: np.ndarray, bj: np.ndarray, n: int, by_bond: bool = False
              ) -> tuple[np.ndarray, np.ndarray]:
     """Per-particle bond index (CSR): ``cbond[cstart[p]:cstart[p+1]]`` are p's bonds: the
@@ -506,18 +558,34 @@ class ParallelBonds:
                 self.newly, self.brk, self.fbond, self.tbi, self.tbj, self.dim, sim.dt,
                 length, sim.box.periodic, summed, sim.ext_force, sim.ext_torque)
         if nnew:
-            self._log_breaks(sim)
+            # the kernel runs before the step counter advances: the break belongs to step + 1
+            self._log_breaks(sim.time + sim.dt, sim.step_count + 1)
         if not summed:  # threaded: each bond stored, gathered per particle in bond order
             gather_bonds.pick(p.n, threads)(self.gstart, self.gbond, self.i, self.mode,
                                             self.fbond, self.tbi, self.tbj, sim.ext_force,
                                             sim.ext_torque)
 
-    def _log_breaks(self, sim: Simulation) -> None:
-        # the kernel runs before the step counter advances: the break belongs to step + 1
+    def compiled(self, sim: Simulation) -> BondStep | None:
+        """The compiled form (``BondStep``) when the bonds run on their serial build
+        (summed straight into the particles), else ``None``."""
+        if not serial_run(self.i.size, sim._threads):
+            return None
+        return BondStep(self.i, self.j, self.rb, self.area, self.inertia, self.polar,
+                        self.kn, self.ks, self.tensile, self.cohesion, self.tan_phi, self.fn,
+                        self.fs, self.mb, self.mt, self.normal, self.mode, self.newly,
+                        self.brk, self.fbond, self.tbi, self.tbj, int(self.dim))
+
+    def after_compiled(self, sim: Simulation, state: BondStep) -> None:
+        """Log the breaks of the compiled loop's last step (it stops after a break)."""
+        if self.newly.any():
+            self._log_breaks(sim.time, sim.step_count)
+
+    def _log_breaks(self, time: float, step: int) -> None:
+        """Log the bonds marked ``newly`` as broken at ``time`` (s), step ``step``."""
         for b in np.flatnonzero(self.newly):
             r = self.brk[b]
             self.log.append(BondBreak(
-                time=sim.time + sim.dt, step=sim.step_count + 1,
+                time=time, step=step,
                 position=(float(r[B_X]), float(r[B_Y]), float(r[B_Z])),
                 mode=MODE_NAMES[int(self.mode[b])], i=int(self.i[b]), j=int(self.j[b]),
                 fn=float(r[B_FN]), fs=float(r[B_FS]), mb=float(r[B_MB]), mt=float(r[B_MT]),

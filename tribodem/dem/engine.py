@@ -14,8 +14,23 @@ from typing import Protocol
 
 import numba
 import numpy as np
+from numba import literal_unroll
 
 from tribodem.dem import laws, neighbors
+from tribodem.dem.compiled import (
+    N_WPAR,
+    W_ALPHA,
+    W_DAMPING,
+    W_MASS,
+    W_MAXSPEED,
+    W_MODE,
+    W_TARGET,
+    NoStep,
+    StepContext,
+    interaction_step,
+    np_sum,
+    registered,
+)
 from tribodem.dem.contact import (
     HIST,
     Material,
@@ -30,6 +45,7 @@ from tribodem.dem.jit import serial_run
 from tribodem.dem.space import Box
 from tribodem.dem.state import ParticleState
 from tribodem.dem.walls import (
+    WALL_MODES,
     PlaneWall,
     near_walls,
     needs_rebuild,
@@ -42,16 +58,160 @@ CHECKPOINT_VERSION = 1
 
 
 @numba.njit(cache=True)
-def _cross_forces(pinfo, pair_i, pair_j, group, out):  # pragma: no cover - numba
-    """Write into ``out`` (in pair order) the normal force of every touching pair
-    (overlap > 0) between different groups that pushes (N > 0); returns their number."""
+def cross_group_sum(pinfo, pair_i, pair_j, group, out):  # pragma: no cover - numba
+    """Summed normal force (N) of the touching pairs (overlap > 0) between different
+    groups that push (N > 0): their forces are written into ``out`` in pair order, then
+    summed as ``np.sum`` does (``compiled.np_sum``: the same bits)."""
     k = 0
     for p in range(pair_i.shape[0]):
         f = pinfo[p, 1]
         if pinfo[p, 0] > 0.0 and f > 0.0 and group[pair_i[p]] != group[pair_j[p]]:
             out[k] = f
             k += 1
-    return k
+    return np_sum(out, k)
+
+
+# compiled builds of the kernels the multi-step loop calls (serial: one thread, or small)
+_pairs_2d = pair_forces_sum_2d.serial
+_pairs_3d = pair_forces_sum.serial
+_walls_pass = wall_forces.serial
+_advance_serial = advance.serial
+_SERVO = WALL_MODES.index("servo")
+_BOUNDARY = WALL_MODES.index("boundary")
+
+
+@numba.njit(cache=True, inline="always")
+def _clamp(v, cap):  # pragma: no cover - numba
+    """``min(max(v, -cap), cap)`` with Python's builtins' choice of argument."""
+    if -cap > v:
+        v = -cap
+    if cap < v:
+        v = cap
+    return v
+
+
+@numba.njit(cache=True)
+def _move_walls(c):  # pragma: no cover - numba
+    """``PlaneWall.update_motion`` of every wall (same operations): servo velocity from
+    the force just measured, then the move."""
+    dt = c.dt
+    for w in range(c.wall_point.shape[0]):
+        mode = int(c.wall_par[w, W_MODE])
+        n0 = c.wall_normal[w, 0]
+        n1 = c.wall_normal[w, 1]
+        n2 = c.wall_normal[w, 2]
+        if mode == _SERVO or mode == _BOUNDARY:
+            cap = c.wall_par[w, W_MAXSPEED]
+            if mode == _SERVO:
+                err = c.wall_par[w, W_TARGET] - c.wall_nf[w]
+                kn = c.wall_tot[w, 4]
+                if kn > 0:
+                    v = c.wall_par[w, W_ALPHA] * err / (kn * dt)
+                else:
+                    v = cap if np.isfinite(cap) else 0.0
+            else:
+                v = (c.wall_vel[w, 0] * n0 + c.wall_vel[w, 1] * n1 + c.wall_vel[w, 2] * n2)
+                a = (c.wall_par[w, W_TARGET] - c.wall_nf[w]
+                     - c.wall_par[w, W_DAMPING] * v) / c.wall_par[w, W_MASS]
+                v = v + a * dt
+            v = _clamp(v, cap)
+            c.wall_vel[w, 0] = v * n0
+            c.wall_vel[w, 1] = v * n1
+            c.wall_vel[w, 2] = v * n2
+        for k in range(3):
+            c.wall_point[w, k] = c.wall_point[w, k] + c.wall_vel[w, k] * dt
+
+
+@numba.njit(cache=True)
+def _must_rebuild(c):  # pragma: no cover - numba
+    """``Simulation._maybe_rebuild``'s test: with walls ``walls.needs_rebuild``, without
+    them ``not drift.max() <= skin / 2`` (numpy's max: a NaN drift rebuilds)."""
+    if c.wall_point.shape[0]:
+        return needs_rebuild(c.drift, c.wall_point, c.wall_normal, c.wall_ref_point,
+                             c.wall_ref_normal, c.half_skin)
+    dmax = 0.0
+    for b in range(c.drift.shape[0]):
+        d = c.drift[b]
+        if d > dmax or d != d:
+            dmax = d
+            if d != d:
+                break
+    return not dmax <= c.half_skin
+
+
+@numba.njit(cache=True)
+def _interactions(states, c):  # pragma: no cover - numba
+    """The interactions' compiled steps, in order; the OR of their event codes."""
+    ev = 0
+    for st in literal_unroll(states):
+        ev |= interaction_step(st, c)
+    return ev
+
+
+#: why ``_run_steps`` returned: the steps asked for are done, a neighbour rebuild is due
+#: before the next step, or an interaction's step function reported an event
+RUN_DONE, RUN_REBUILD, RUN_EVENT = 0, 1, 2
+
+
+@numba.njit(cache=True)
+def _run_steps(c, states, nmax):  # pragma: no cover - numba
+    """Up to ``nmax`` steps of ``Simulation.step`` in one compiled loop (serial kernels,
+    the same operations in the same order, so the same bits): pair contacts -> the
+    interactions' compiled steps (``states``, in order) -> wall pass and the walls'
+    totals -> particle update -> wall motion -> clock. The first step starts at once (the
+    caller has just checked the neighbour list); before each later one the rebuild test
+    runs and, if due, the loop stops. Returns (steps done, ``RUN_*`` reason, the OR of
+    the interactions' event codes)."""
+    nw = c.wall_point.shape[0]
+    n = c.pos.shape[0]
+    k = 0
+    why = RUN_DONE
+    events = 0
+    t = c.clock[0]
+    while k < nmax:
+        if k > 0 and _must_rebuild(c):
+            why = RUN_REBUILD
+            break
+        if c.dim == 2:
+            _pairs_2d(c.pos, c.vel, c.omega, c.radius, c.mass, c.inertia, c.mat, c.pair_i,
+                      c.pair_j, c.hist, c.pairtab, c.elin, c.length, c.periodic, c.dim,
+                      c.thickness, c.dt, c.fpair, c.tpair_i, c.tpair_j, c.pinfo, c.force,
+                      c.torque)
+        else:
+            _pairs_3d(c.pos, c.vel, c.omega, c.radius, c.mass, c.inertia, c.mat, c.pair_i,
+                      c.pair_j, c.hist, c.pairtab, c.elin, c.length, c.periodic, c.dim,
+                      c.thickness, c.dt, c.fpair, c.tpair_i, c.tpair_j, c.pinfo, c.force,
+                      c.torque)
+        ev = 0
+        if c.has_ext:
+            for i in range(n):
+                for d in range(3):
+                    c.ext_force[i, d] = 0.0
+                    c.ext_torque[i, d] = 0.0
+            ev = _interactions(states, c)
+        if nw:
+            _walls_pass(c.pos, c.vel, c.omega, c.radius, c.mass, c.inertia, c.mat, c.wstart,
+                        c.wid, c.wpart, c.wbstart, c.wall_point, c.wall_normal, c.wall_vel,
+                        c.wall_mat, c.wall_hist, c.wall_info, c.wsum, c.pairtab, c.elin,
+                        c.dim, c.thickness, c.dt, c.wforce, c.wtorque, c.wall_tot)
+            for w in range(nw):  # Simulation._wall_pass: the normal force on each wall
+                c.wall_nf[w] = -(c.wall_tot[w, 0] * c.wall_normal[w, 0]
+                                 + c.wall_tot[w, 1] * c.wall_normal[w, 1]
+                                 + c.wall_tot[w, 2] * c.wall_normal[w, 2])
+        _advance_serial(c.pos, c.vel, c.omega, c.radius, c.mass, c.inertia, c.fixed,
+                        c.start, c.rev_start, c.rev_pair, c.fpair, c.tpair_i, c.tpair_j,
+                        True, c.wstart, c.wforce, c.wtorque, c.dt, c.gravity, c.viscous,
+                        c.local, c.has_ext, c.ext_force, c.ext_torque, c.force, c.torque,
+                        c.ref_pos, c.ref_radius, c.lo, c.length, c.periodic, c.drift)
+        _move_walls(c)
+        t += c.dt
+        k += 1
+        if ev:
+            events |= ev
+            why = RUN_EVENT
+            break
+    c.clock[0] = t
+    return k, why, events
 
 
 class Interaction(Protocol):
@@ -62,6 +222,14 @@ class Interaction(Protocol):
     Optional hooks: ``after_advance(sim)`` runs right after the particle update (rigid
     clumps integrate their bodies there); ``filter_pairs(nl)`` returns the neighbour list
     without pairs that must not interact (members of one clump), after every build.
+
+    Compiled form (optional, :mod:`tribodem.dem.compiled`): ``compiled(sim)`` returns the
+    state of a registered compiled step that does what ``compute`` does (the same
+    operations: the same bits), or ``None`` when it has none now; ``after_compiled(sim,
+    state)`` runs whenever the compiled loop returns to Python. ``Simulation.step`` runs
+    its steps in one compiled loop while every interaction has one (and no
+    ``after_advance`` hook, energy tracking, extra contact law or threaded kernel is in
+    play); otherwise step by step in Python.
     """
 
     def compute(self, sim: Simulation) -> None: ...
@@ -83,6 +251,8 @@ class Simulation:
     ``dt_safety`` x critical step), ``viscous_damping`` c (1/s, seed 000 eq 1 eta = c m),
     ``local_damping`` alpha (PFC), ``skin`` (m; default 0.2 x mean radius).
     A ``dt`` above the critical step is refused (``TimeStepError``) unless ``force_dt``.
+    ``compiled_loop``: run steps in the compiled multi-step loop when every piece allows
+    it (see ``Interaction``; the same results as the Python loop, bitwise).
     """
 
     def __init__(self, particles: ParticleState, materials: list[Material], box: Box,
@@ -106,6 +276,9 @@ class Simulation:
         self._after: list = []  # interactions with an after_advance hook
         self._pair_filters: list = []  # interactions with a filter_pairs hook
         self.recorders: list[tuple[int, Recorder]] = []
+        #: run steps in the compiled loop (``_run_steps``) whenever every piece has a
+        #: compiled form; False: always the Python loop (the same results)
+        self.compiled_loop = True
         self.step_count = 0
         self.time = 0.0
         self._validate(dt, dt_safety)
@@ -331,40 +504,129 @@ class Simulation:
         A step: neighbour list if needed -> pair contacts -> extra interactions (into
         ``ext_force``/``ext_torque``) -> per particle: gather, walls, update, wrap ->
         ``after_advance`` hooks (clump bodies) -> walls move (servo uses the wall force
-        just measured).
+        just measured). Runs of steps go through one compiled loop when every piece has a
+        compiled form (``_compiled_states``), else step by step in Python.
         """
         self._threads = numba.get_num_threads()  # once per call: kernels pick builds by it
         self.box_length = self.box.length  # once per call (the property makes an array)
         try:
             if self.step_count == 0 and self.time == 0.0:
                 self._sample(force=True)
-            for _ in range(n):
-                # the walls' arrays of this step (they move only after the update)
-                self._refresh_walls()
-                self._maybe_rebuild()
-                self._pair_forces()
-                if self.interactions:
-                    self.ext_force[:] = 0.0
-                    self.ext_torque[:] = 0.0
-                    for inter in self.interactions:
-                        inter.compute(self)
-                if self.track_energy:
-                    p = self.p
-                    self._at_force_eval = (p.pos.copy(), p.vel.copy(), p.omega.copy())
-                self._wall_pass()
-                self._advance()
-                for inter in self._after:
-                    inter.after_advance(self)
-                for w in self.walls:
-                    w.update_motion(self.dt)
-                self.step_count += 1
-                self.time += self.dt
-                if self.step_count % self.check_every == 0:
-                    self.check_stability()
-                self._sample()
+            done = 0
+            while done < n:
+                states = self._compiled_states()
+                if states is None:
+                    self._python_step()
+                    done += 1
+                else:
+                    done += self._compiled_run(states, n - done)
         except SimulationUnstable:
             self.close_recorders()
             raise
+
+    def _python_step(self) -> None:
+        """One step, piece by piece in Python."""
+        # the walls' arrays of this step (they move only after the update)
+        self._refresh_walls()
+        self._maybe_rebuild()
+        self._pair_forces()
+        if self.interactions:
+            self.ext_force[:] = 0.0
+            self.ext_torque[:] = 0.0
+            for inter in self.interactions:
+                inter.compute(self)
+        if self.track_energy:
+            p = self.p
+            self._at_force_eval = (p.pos.copy(), p.vel.copy(), p.omega.copy())
+        self._wall_pass()
+        self._advance()
+        for inter in self._after:
+            inter.after_advance(self)
+        for w in self.walls:
+            w.update_motion(self.dt)
+        self.step_count += 1
+        self.time += self.dt
+        if self.step_count % self.check_every == 0:
+            self.check_stability()
+        self._sample()
+
+    def _compiled_states(self) -> tuple | None:
+        """The interactions' compiled states (in order, closed by ``NoStep``) if the next
+        steps can run in the compiled loop: every kernel on its serial build, the built-in
+        contact laws only, no ``after_advance`` hook, no energy tracking, and a compiled
+        form from every interaction; else ``None``."""
+        if (not self.compiled_loop or self.track_energy or self._after
+                or len(laws.modules()) != len(laws.BUILTIN)
+                or not serial_run(max(self.p.n, self.nl.n_pairs), self._threads)):
+            return None
+        states = []
+        for inter in self.interactions:
+            form = getattr(inter, "compiled", None)
+            st = form(self) if form is not None else None
+            if st is None or not registered(st):
+                return None
+            states.append(st)
+        states.append(NoStep())
+        return tuple(states)
+
+    def _context(self) -> StepContext:
+        """The arrays and constants of the compiled loop (shared with this object)."""
+        p, nl = self.p, self.nl
+        wp, wn, wv, wm = self._walls_now
+        nw = len(self.walls)
+        wpar = np.zeros((nw, N_WPAR))
+        wnf = np.zeros(nw)
+        for k, w in enumerate(self.walls):
+            wpar[k] = (WALL_MODES.index(w.mode), w.target_force, w.servo_mass,
+                       w.servo_damping, w.servo_gain_alpha, w.max_speed)
+            wnf[k] = w.normal_force
+        ref_p, ref_n = self._wall_ref if nw else (np.zeros((0, 3)), np.zeros((0, 3)))
+        return StepContext(
+            p.pos, p.vel, p.omega, p.radius, p.mass, p.inertia, p.mat, p.group, p.fixed,
+            self.force, self.torque, self.ext_force, self.ext_torque, nl.start, nl.pair_i,
+            nl.pair_j, nl.rev_start, nl.rev_pair, nl.ref_pos, nl.ref_radius, self.hist,
+            self.pinfo, self.fpair, self.tpair_i, self.tpair_j, self.pairtab, self.elin,
+            self._wstart, self._wid, self._wpart, self._wbstart, self.wall_hist,
+            self.wall_info, self._wsum, self._wforce, self._wtorque, self._wtot, wp, wn, wv,
+            wm, wpar, wnf, ref_p, ref_n, self.drift, self.gravity, self.box.lo,
+            self.box_length, self.box.periodic, np.array([self.time]), int(p.dim),
+            float(p.thickness), float(self.dt), self.viscous_damping, self.local_damping,
+            bool(self.interactions), 0.5 * self.skin)
+
+    def _compiled_run(self, states: tuple, nmax: int) -> int:
+        """Steps in the compiled loop (``_run_steps``), at most ``nmax``, up to the next
+        event: a neighbour rebuild, an interaction's event, a stability check or a
+        recorder sample (those run here, in Python, as in ``_python_step``). Returns the
+        steps done (>= 1)."""
+        self._refresh_walls()
+        self._maybe_rebuild()
+        limit = min(nmax, self.check_every - self.step_count % self.check_every)
+        for every, _ in self.recorders:
+            limit = min(limit, every - self.step_count % every)
+        c = self._context()
+        k, _why, _events = _run_steps(c, states, limit)
+        self._summed = True
+        self._evaluated = True
+        rows = c.wall_tot.tolist()
+        for w_id, w in enumerate(self.walls):
+            f0, f1, f2, nc, kn = rows[w_id]
+            w.force = np.array((f0, f1, f2))
+            w.normal_force = float(c.wall_nf[w_id])
+            w.contacts = int(nc)
+            w.stiffness = kn
+            w.target_force = float(c.wall_par[w_id, W_TARGET])
+            w.velocity = c.wall_vel[w_id].copy()
+            w.point = c.wall_point[w_id].copy()
+        self.step_count += k
+        self.time = float(c.clock[0])
+        for inter, st in zip(self.interactions, states, strict=False):
+            hook = getattr(inter, "after_compiled", None)
+            if hook is not None:
+                hook(self, st)
+        if self.step_count % self.check_every == 0:
+            self.check_stability()
+        self._sample()
+        return k
 
     def run(self, steps: int, progress: bool = False, chunk: int = 1000) -> None:
         """Advance ``steps`` steps, optionally with a progress bar."""
@@ -475,9 +737,8 @@ class Simulation:
             return float(f[(g[c["i"]] != g[c["j"]]) & (f > 0)].sum())
         if self._cross.shape[0] != self.nl.n_pairs:
             self._cross = np.zeros(self.nl.n_pairs)
-        k = _cross_forces(self.pinfo, self.nl.pair_i, self.nl.pair_j, self.p.group,
-                          self._cross)
-        return float(self._cross[:k].sum())
+        return float(cross_group_sum(self.pinfo, self.nl.pair_i, self.nl.pair_j,
+                                     self.p.group, self._cross))
 
     def n_contacts(self) -> int:
         """Particle-particle contacts carrying force (touching, before the first step)."""

@@ -77,7 +77,10 @@ class PlaneWall:
             speed = min(max(float(speed), -self.max_speed), self.max_speed)  # np.clip, 50x faster
             self.velocity = speed * self.normal
         elif self.mode == "boundary":
-            v = float(self.velocity @ self.normal)  # speed towards the particles
+            # speed towards the particles (the dot product written out, as the compiled
+            # loop does: engine._move_walls)
+            (v0, v1, v2), (n0, n1, n2) = self.velocity.tolist(), self.normal.tolist()
+            v = v0 * n0 + v1 * n1 + v2 * n2
             a = (self.target_force - self.normal_force - self.servo_damping * v) / self.servo_mass
             v = min(max(v + a * dt, -self.max_speed), self.max_speed)
             self.velocity = v * self.normal
