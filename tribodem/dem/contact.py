@@ -277,12 +277,47 @@ def _lin_k(prop, ri, rj, ei, ej, dim, thickness):
 
 
 @njit(cache=True, inline="always")
-def _pair(d0, d1, d2, dist, ri, rj, vi0, vi1, vi2, vj0, vj1, vj2, wi0, wi1, wi2, wj0, wj1, wj2, mi,
-          mj, ii, ij, prop, lin_k, h0, h1, h2, dt):
+def _pair_consts(prop, ri, rj, mi, mj, ii, ij, ei, ej, dim, thickness):
+    """The constants of a pair (fixed while radii, masses and materials are): the linear
+    law's stiffness ``lin_k`` (N/m, ``_lin_k``), effective radius R* (m), mass m* (kg) and
+    inertia I* (kg m^2; 0 without rolling friction)."""
+    lin_k = _lin_k(prop, ri, rj, ei, ej, dim, thickness)
+    rstar = ri * rj / (ri + rj)
+    mstar = mi * mj / (mi + mj)
+    istar = ii * ij / (ii + ij) if prop[P_MUR] > 0.0 else 0.0  # rolling friction only
+    return lin_k, rstar, mstar, istar
+
+
+#: columns of the per-pair constants (``pair_constants``)
+C_LINK, C_RSTAR, C_MSTAR, C_ISTAR = range(4)
+N_PCONST = 4
+
+
+@njit(cache=True)
+def pair_constants(radius, mass, inertia, mat, pair_i, pair_j, pairtab, elin, dim, thickness,
+                   out):  # pragma: no cover - numba
+    """``out[p]`` = the constants of listed pair p (``_pair_consts``: lin_k N/m, R* m,
+    m* kg, I* kg m^2), computed as the pair kernels compute them (the same bits): kernels
+    given them skip five divisions per contact."""
+    for p in range(pair_i.shape[0]):
+        i = pair_i[p]
+        j = pair_j[p]
+        mi = mat[i]
+        mj = mat[j]
+        (out[p, C_LINK], out[p, C_RSTAR], out[p, C_MSTAR],
+         out[p, C_ISTAR]) = _pair_consts(pairtab[mi, mj], radius[i], radius[j], mass[i],
+                                         mass[j], inertia[i], inertia[j], elin[mi], elin[mj],
+                                         dim, thickness)
+
+
+@njit(cache=True, inline="always")
+def _pair(d0, d1, d2, dist, ri, rj, vi0, vi1, vi2, vj0, vj1, vj2, wi0, wi1, wi2, wj0, wj1, wj2,
+          rstar, mstar, istar, prop, lin_k, h0, h1, h2, dt):
     """Contact of two touching particles i, j at separation d = x_j - x_i (m; ``dist`` =
-    ``|d|`` below r_i + r_j): radii (m), velocities (m/s), spins (1/s), masses (kg),
-    inertias (kg m^2), the pair's property row, the linear law's stiffness ``lin_k`` (N/m,
-    ``_lin_k``), the shear spring ``h`` (m). Returns (force on j (3, N; i gets minus it),
+    ``|d|`` below r_i + r_j): radii (m), velocities (m/s), spins (1/s), the pair's
+    constants R* (m), m* (kg), I* (kg m^2) and linear-law stiffness ``lin_k`` (N/m; all
+    from ``_pair_consts``), its property row, the shear spring ``h`` (m). Returns (force on
+    j (3, N; i gets minus it),
     torque on i (3, N m), torque on j (3, N m), overlap m, normal force N, energy J,
     kn N/m, the new shear spring (3, m)). Scalars and the property row only, so it inlines
     into the pair loops without reference counting (and stays under 30 arguments: more
@@ -298,9 +333,6 @@ def _pair(d0, d1, d2, dist, ri, rj, vi0, vi1, vi2, vj0, vj1, vj2, wi0, wi1, wi2,
     v0 = (vj0 - aj * (wj1 * n2 - wj2 * n1)) - (vi0 + ai * (wi1 * n2 - wi2 * n1))
     v1 = (vj1 - aj * (wj2 * n0 - wj0 * n2)) - (vi1 + ai * (wi2 * n0 - wi0 * n2))
     v2 = (vj2 - aj * (wj0 * n1 - wj1 * n0)) - (vi2 + ai * (wi0 * n1 - wi1 * n0))
-    rstar = ri * rj / (ri + rj)
-    mstar = mi * mj / (mi + mj)
-    istar = ii * ij / (ii + ij) if prop[P_MUR] > 0.0 else 0.0  # rolling friction only
     law = int(prop[P_LAW])
     f0, f1, f2, r0, r1, r2, fn, energy, kn, h0, h1, h2 = response(
         law, prop, n0, n1, n2, delta, v0, v1, v2, wi0 - wj0, wi1 - wj1,
@@ -339,12 +371,14 @@ def pair_forces(pos, vel, omega, radius, mass, inertia, mat, pair_i, pair_j, his
         delta = rs - dist
         if delta > 0.0 and dist2 > 0.0:
             prop = pairtab[mat[i], mat[j]]
+            lin_k, rstar, mstar, istar = _pair_consts(
+                prop, ri, rj, mass[i], mass[j], inertia[i], inertia[j], elin[mat[i]],
+                elin[mat[j]], dim, thickness)
             (f0, f1, f2, a0, a1, a2, b0, b1, b2, delta, fn, energy, kn, h0, h1, h2) = _pair(
                 d0, d1, d2, dist, ri, rj, vel[i, 0], vel[i, 1], vel[i, 2], vel[j, 0], vel[j, 1],
                 vel[j, 2], omega[i, 0], omega[i, 1], omega[i, 2], omega[j, 0], omega[j, 1],
-                omega[j, 2], mass[i], mass[j], inertia[i], inertia[j], prop,
-                _lin_k(prop, ri, rj, elin[mat[i]], elin[mat[j]], dim, thickness),
-                hist[p, 0], hist[p, 1], hist[p, 2], dt)
+                omega[j, 2], rstar, mstar, istar, prop, lin_k, hist[p, 0], hist[p, 1],
+                hist[p, 2], dt)
             hist[p, 0] = h0
             hist[p, 1] = h1
             hist[p, 2] = h2
@@ -378,7 +412,7 @@ def pair_forces(pos, vel, omega, radius, mass, inertia, mat, pair_i, pair_j, his
 @kernel
 def pair_forces_sum(pos, vel, omega, radius, mass, inertia, mat, pair_i, pair_j, hist, pairtab,
                     elin, length, periodic, dim, thickness, dt, fpair, tpair_i, tpair_j, pinfo,
-                    force, torque):
+                    force, torque, pconst):
     """Serial pass of ``pair_forces`` that also sums every pair straight into the particles
     (Newton pairs, as LIGGGHTS): ``force``/``torque`` (N, N m) are zeroed, then each
     touching pair p adds ``-fpair[p]`` / its torque on i to i and ``+fpair[p]`` / its
@@ -389,6 +423,10 @@ def pair_forces_sum(pos, vel, omega, radius, mass, inertia, mat, pair_i, pair_j,
     by lower particles), then its own -- the order in which ``integrate.advance`` gathers
     them after the threaded ``pair_forces``, so both give bitwise the same sums. Run it
     through its serial build only (the loop writes shared rows).
+
+    ``pconst``: the pairs' constants (``pair_constants``, valid while radii, masses and
+    materials are unchanged) or ``None`` (computed per contact): the same values either
+    way (each is its own compiled specialization).
     """
     n = force.shape[0]
     for i in range(n):
@@ -411,12 +449,20 @@ def pair_forces_sum(pos, vel, omega, radius, mass, inertia, mat, pair_i, pair_j,
         delta = rs - dist
         if delta > 0.0 and dist2 > 0.0:
             prop = pairtab[mat[i], mat[j]]
+            if pconst is None:  # (a compile-time branch: None is its own type)
+                lin_k, rstar, mstar, istar = _pair_consts(
+                    prop, ri, rj, mass[i], mass[j], inertia[i], inertia[j], elin[mat[i]],
+                    elin[mat[j]], dim, thickness)
+            else:  # the constants given (the compiled multi-step loop)
+                lin_k = pconst[p, C_LINK]
+                rstar = pconst[p, C_RSTAR]
+                mstar = pconst[p, C_MSTAR]
+                istar = pconst[p, C_ISTAR]
             (f0, f1, f2, a0, a1, a2, b0, b1, b2, delta, fn, energy, kn, h0, h1, h2) = _pair(
                 d0, d1, d2, dist, ri, rj, vel[i, 0], vel[i, 1], vel[i, 2], vel[j, 0], vel[j, 1],
                 vel[j, 2], omega[i, 0], omega[i, 1], omega[i, 2], omega[j, 0], omega[j, 1],
-                omega[j, 2], mass[i], mass[j], inertia[i], inertia[j], prop,
-                _lin_k(prop, ri, rj, elin[mat[i]], elin[mat[j]], dim, thickness),
-                hist[p, 0], hist[p, 1], hist[p, 2], dt)
+                omega[j, 2], rstar, mstar, istar, prop, lin_k, hist[p, 0], hist[p, 1],
+                hist[p, 2], dt)
             hist[p, 0] = h0
             hist[p, 1] = h1
             hist[p, 2] = h2
@@ -506,8 +552,8 @@ def response_2d(law, prop, n0, n1, delta, v0, v1, w2, rstar, mstar, istar, lin_k
 
 
 @njit(cache=True, inline="always")
-def _pair_2d(d0, d1, dist, ri, rj, vi0, vi1, vj0, vj1, wi2, wj2, mi, mj, ii, ij, prop, lin_k,
-             h0, h1, dt):
+def _pair_2d(d0, d1, dist, ri, rj, vi0, vi1, vj0, vj1, wi2, wj2, rstar, mstar, istar, prop,
+             lin_k, h0, h1, dt):
     """``_pair`` for two disks in the plane (see ``response_2d``). Returns (force on j
     (x, y), torque on i (z), torque on j (z), overlap, normal force, energy, kn, shear
     spring (x, y))."""
@@ -519,9 +565,6 @@ def _pair_2d(d0, d1, dist, ri, rj, vi0, vi1, vj0, vj1, wi2, wj2, mi, mj, ii, ij,
     aj = rj - 0.5 * delta
     v0 = (vj0 + aj * (wj2 * n1)) - (vi0 - ai * (wi2 * n1))
     v1 = (vj1 - aj * (wj2 * n0)) - (vi1 + ai * (wi2 * n0))
-    rstar = ri * rj / (ri + rj)
-    mstar = mi * mj / (mi + mj)
-    istar = ii * ij / (ii + ij) if prop[P_MUR] > 0.0 else 0.0  # rolling friction only
     law = int(prop[P_LAW])
     f0, f1, r2, fn, energy, kn, h0, h1 = response_2d(
         law, prop, n0, n1, delta, v0, v1, wi2 - wj2, rstar, mstar, istar, lin_k, h0, h1, dt)
@@ -532,12 +575,12 @@ def _pair_2d(d0, d1, dist, ri, rj, vi0, vi1, vj0, vj1, wi2, wj2, mi, mj, ii, ij,
 @kernel
 def pair_forces_sum_2d(pos, vel, omega, radius, mass, inertia, mat, pair_i, pair_j, hist,
                        pairtab, elin, length, periodic, dim, thickness, dt, fpair, tpair_i,
-                       tpair_j, pinfo, force, torque):
+                       tpair_j, pinfo, force, torque, pconst):
     """``pair_forces_sum`` for disks (dim 2, ``FIX_2D``): the same operations without the
     terms that are exactly zero in the plane (``_pair_2d``), so the same values (only
     signs of zeros may differ) in fewer instructions. Leaves the z of ``force`` and
     ``fpair``, the x and y of ``torque`` and the z of ``hist`` as they are (zero).
-    Serial build only."""
+    ``pconst`` as in ``pair_forces_sum``. Serial build only."""
     n = force.shape[0]
     for i in range(n):
         for k in range(3):
@@ -567,11 +610,18 @@ def pair_forces_sum_2d(pos, vel, omega, radius, mass, inertia, mat, pair_i, pair
             pinfo[p, 0] = delta
             continue
         prop = pairtab[mat[i], mat[j]]
+        if pconst is None:  # (a compile-time branch: None is its own type)
+            lin_k, rstar, mstar, istar = _pair_consts(
+                prop, ri, rj, mass[i], mass[j], inertia[i], inertia[j], elin[mat[i]],
+                elin[mat[j]], dim, thickness)
+        else:  # the constants given (the compiled multi-step loop)
+            lin_k = pconst[p, C_LINK]
+            rstar = pconst[p, C_RSTAR]
+            mstar = pconst[p, C_MSTAR]
+            istar = pconst[p, C_ISTAR]
         f0, f1, a2, b2, delta, fn, energy, kn, h0, h1 = _pair_2d(
             d0, d1, dist, ri, rj, vel[i, 0], vel[i, 1], vel[j, 0], vel[j, 1], omega[i, 2],
-            omega[j, 2], mass[i], mass[j], inertia[i], inertia[j], prop,
-            _lin_k(prop, ri, rj, elin[mat[i]], elin[mat[j]], dim, thickness), hist[p, 0],
-            hist[p, 1], dt)
+            omega[j, 2], rstar, mstar, istar, prop, lin_k, hist[p, 0], hist[p, 1], dt)
         hist[p, 0] = h0
         hist[p, 1] = h1
         fpair[p, 0] = f0

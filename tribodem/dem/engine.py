@@ -33,7 +33,9 @@ from tribodem.dem.compiled import (
 )
 from tribodem.dem.contact import (
     HIST,
+    N_PCONST,
     Material,
+    pair_constants,
     pair_forces,
     pair_forces_sum,
     pair_forces_sum_2d,
@@ -168,6 +170,11 @@ def _run_steps(c, states, nmax):  # pragma: no cover - numba
     why = RUN_DONE
     events = 0
     t = c.clock[0]
+    # the pairs' constants, once per call: no compiled step changes radii, masses or
+    # materials, and the list is rebuilt only between calls
+    pconst = np.empty((c.pair_i.shape[0], N_PCONST))
+    pair_constants(c.radius, c.mass, c.inertia, c.mat, c.pair_i, c.pair_j, c.pairtab, c.elin,
+                   c.dim, c.thickness, pconst)
     while k < nmax:
         if k > 0 and _must_rebuild(c):
             why = RUN_REBUILD
@@ -176,12 +183,12 @@ def _run_steps(c, states, nmax):  # pragma: no cover - numba
             _pairs_2d(c.pos, c.vel, c.omega, c.radius, c.mass, c.inertia, c.mat, c.pair_i,
                       c.pair_j, c.hist, c.pairtab, c.elin, c.length, c.periodic, c.dim,
                       c.thickness, c.dt, c.fpair, c.tpair_i, c.tpair_j, c.pinfo, c.force,
-                      c.torque)
+                      c.torque, pconst)
         else:
             _pairs_3d(c.pos, c.vel, c.omega, c.radius, c.mass, c.inertia, c.mat, c.pair_i,
                       c.pair_j, c.hist, c.pairtab, c.elin, c.length, c.periodic, c.dim,
                       c.thickness, c.dt, c.fpair, c.tpair_i, c.tpair_j, c.pinfo, c.force,
-                      c.torque)
+                      c.torque, pconst)
         ev = 0
         if c.has_ext:
             for i in range(n):
@@ -462,7 +469,7 @@ class Simulation:
         self._summed = serial_run(self.nl.n_pairs, self._threads)
         if self._summed:
             fn = pair_forces_sum_2d if p.dim == 2 else pair_forces_sum
-            laws.active(fn).serial(*args, self.force, self.torque)
+            laws.active(fn).serial(*args, self.force, self.torque, None)
         else:
             laws.active(pair_forces).pick(self.nl.n_pairs, self._threads)(*args)
         self._evaluated = True
