@@ -8,7 +8,7 @@ from pathlib import Path
 
 from conftest import run_tribodem
 
-from tribodem.fretting.study import SEED, compare, ranking, stages
+from tribodem.fretting.study import SEED, Stage, compare, ranking, row_of, stages
 
 CONFIG = """[contact]
 n = 32
@@ -54,6 +54,15 @@ def test_compare_and_ranking() -> None:
     assert t[("swt", "cycles_to_first_wear_lower")]["within_20pct"] is True  # 700 / 600
     assert len(t) == sum(len(v) for v in SEED.values())
     assert ranking(rows) == ["von_mises", "energy", "swt"]
+    # a stage stopped before its first cycle measured nothing: not run, not ranked
+    summary = {"cycles": 0, "cycles_simulated": 0, "wear_depth_mean_scar_lower_m": 0.0,
+               "wear_depth_mean_scar_upper_m": 0.0, "wear_depth_lower_m": 0.0,
+               "wear_depth_upper_m": 0.0, "wear_volume_lower_m3": 0.0, "wall_time_s": 1.0}
+    s22 = row_of(Stage("s22", "s22", 1), summary)
+    assert s22["mean_scar_depth_per_cycle_lower_m"] is None
+    t = {(r["stage"], r["quantity"]): r for r in compare([*rows, s22])}
+    assert t[("s22", "mean_scar_depth_lower_m")]["ours"] is None
+    assert ranking([*rows, s22]) == ["von_mises", "energy", "swt"]
 
 
 def test_study_command(tmp_path: Path) -> None:

@@ -94,7 +94,9 @@ def row_of(st: Stage, summary: dict[str, Any]) -> dict[str, Any]:
         "worn_volume_lower_m3": summary["wear_volume_lower_m3"],
         "wall_time_s": summary["wall_time_s"],
     }
-    row["mean_scar_depth_per_cycle_lower_m"] = row["mean_scar_depth_lower_m"] / n
+    # a stage stopped before its first cycle measured nothing (not a zero rate)
+    row["mean_scar_depth_per_cycle_lower_m"] = (row["mean_scar_depth_lower_m"] / n if n > 0
+                                                else None)
     for key in ("cycles_to_first_wear_upper", "cycles_to_first_wear_lower",
                 "cycles_to_first_wear_upper_centre"):
         if key in crit:
@@ -117,7 +119,8 @@ def compare(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
     for stage, nums in SEED.items():
         r = by.get(stage)
         for q, seed in nums.items():
-            ours = None if r is None or r.get("skipped") else r.get(q)
+            ran = r is not None and not r.get("skipped") and r.get("cycles") != 0
+            ours = r.get(q) if ran else None
             ratio = ours / seed if ours is not None and seed and math.isfinite(ours) else None
             bound = (stage, q) in SEED_LOWER_BOUNDS
             if bound and ours is not None and ours == math.inf:
@@ -136,7 +139,8 @@ def ranking(rows: list[dict[str, Any]]) -> list[str]:
         if v == 0 and r.get("cycles_to_first_wear_lower"):
             return -1.0 / float(r["cycles_to_first_wear_lower"])  # below every wearing one
         return v
-    done = [r for r in rows if not r.get("skipped") and r["stage"] != "shear_jump"]
+    done = [r for r in rows if not r.get("skipped") and r.get("cycles") != 0
+            and r["stage"] != "shear_jump"]
     return [r["stage"] for r in sorted(done, key=rate, reverse=True)]
 
 
@@ -153,6 +157,10 @@ def write_markdown(out: Path, rows: list[dict[str, Any]], table: list[dict[str, 
     for r in rows:
         if r.get("skipped"):
             lines.append(f"| {r['stage']} | skipped: {r['skipped']} | | | | | |")
+            continue
+        if not r["cycles"]:
+            lines.append(f"| {r['stage']} | none: {r.get('stopped', 'stopped')} | | | | | "
+                         f"{r['wall_time_s']:.1f} |")
             continue
         swt = (f"{r.get('cycles_to_first_wear_lower', float('nan')):.4g} / "
                f"{r.get('cycles_to_first_wear_upper', float('nan')):.4g}"
