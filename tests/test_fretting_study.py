@@ -4,9 +4,12 @@ small grid with the elastic half-space."""
 from __future__ import annotations
 
 import json
+import subprocess
+import time
 from pathlib import Path
 
-from conftest import run_tribodem
+import pytest
+from conftest import default_sigint, run_tribodem, tribodem_exe
 
 from tribodem.fretting.study import SEED, Stage, compare, ranking, row_of, stages
 
@@ -104,6 +107,35 @@ def test_study_command(tmp_path: Path) -> None:
     assert r3.returncode == 3, r3.stderr
     s3 = json.loads((tmp_path / "stop" / "study.json").read_text())
     assert "window" in s3["rows"][0]["stopped"] and (tmp_path / "stop" / "study.md").is_file()
+
+
+def test_ctrl_c_exits_130_naming_the_stage_then_resume_finishes(tmp_path: Path) -> None:
+    """Ctrl-C during a stage: exit 130, no traceback, the stage's folder and checkpoint named;
+    ``--resume`` then finishes the study with the stage's 30 cycles."""
+    import signal
+
+    cfg = tmp_path / "c.toml"
+    cfg.write_text(CONFIG + "figures = false\n")
+    out = tmp_path / "study"
+    args = ["fretting", "study", "--config", str(cfg), "--stages", "energy", "--out",
+            str(out), "--no-progress"]
+    proc = subprocess.Popen([tribodem_exe(), *args], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, preexec_fn=default_sigint)
+    ck = out / "energy" / "checkpoint.npz"
+    t_end = time.monotonic() + 120
+    while not ck.exists() and proc.poll() is None and time.monotonic() < t_end:
+        time.sleep(0.02)
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=60)
+    if proc.returncode == 0:
+        pytest.skip("the study finished before Ctrl-C")
+    assert proc.returncode == 130, err
+    assert "Traceback" not in err, err
+    assert str(out / "energy") in err and "checkpoint" in err and "--resume" in err, err
+    r = run_tribodem(*args, "--resume")
+    assert r.returncode == 0, r.stderr
+    rows = json.loads((out / "study.json").read_text())["rows"]
+    assert rows[0]["cycles"] == 30
 
 
 def test_select_stages() -> None:
