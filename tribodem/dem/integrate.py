@@ -19,6 +19,7 @@ from tribodem.dem import laws
 from tribodem.dem.jit import kernel
 from tribodem.dem.laws.table import P_KRATIO, P_LAW
 from tribodem.dem.space import min_image
+from tribodem.dem.state import FIX_2D
 
 BLOCK = 256  # particles per block: fixed, so block sums do not depend on the thread count
 
@@ -155,8 +156,19 @@ def advance(pos, vel, omega, radius, mass, inertia, fixed, start, rev_start, rev
             torque[i, 1] = t1
             torque[i, 2] = t2
             m = mass[i]
-            _update(pos, vel, omega, i, f0 + m * g0, f1 + m * g1, f2 + m * g2, t0, t1, t2, m,
-                     inertia[i], fixed[i], a, b, local, dt)
+            fx = fixed[i]
+            if fx == FIX_2D and local == 0.0:
+                # a free disk (x, y, rz; z, rx, ry fixed): ``_update``'s general path
+                # written out for it (the same operations, without its per-DOF loops)
+                vel[i, 0] = a * vel[i, 0] + b * (f0 + m * g0) / m
+                vel[i, 1] = a * vel[i, 1] + b * (f1 + m * g1) / m
+                omega[i, 2] = a * omega[i, 2] + b * t2 / inertia[i]
+                pos[i, 0] += vel[i, 0] * dt
+                pos[i, 1] += vel[i, 1] * dt
+                pos[i, 2] += vel[i, 2] * dt
+            else:
+                _update(pos, vel, omega, i, f0 + m * g0, f1 + m * g1, f2 + m * g2, t0, t1,
+                        t2, m, inertia[i], fx, a, b, local, dt)
             if wrap:
                 for k in range(3):
                     if periodic[k]:
