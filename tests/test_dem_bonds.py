@@ -12,6 +12,7 @@ from tribodem.dem.bonds import (
     bond_csr,
     bond_forces,
     bond_forces_2d,
+    bond_screen,
     gather_bonds,
     install_bonds_by_gap,
 )
@@ -284,6 +285,44 @@ def test_2d_kernel_matches_the_general_one() -> None:
         assert 0 < n1 == n2 < nb
         for x, y in zip(a1 + e1, a2 + e2, strict=True):
             assert np.array_equal(x, y)
+
+
+def test_2d_screen_gives_the_same_bits() -> None:
+    """``bond_forces_2d`` with its strength screen (reciprocals first, the divisions only
+    near a limit) decides every bond as without it: the same arrays, the same breaks."""
+    rng = np.random.default_rng(8)
+    n, nb = 600, 1500
+    pos = np.c_[rng.uniform(0, 0.05, (n, 2)), np.zeros(n)]
+    vel = np.c_[rng.normal(0, 1e-3, (n, 2)), np.zeros(n)]
+    omega = np.c_[np.zeros((n, 2)), rng.normal(0, 1e-1, n)]
+    radius = rng.uniform(0.8, 1.2, n) * R
+    i = rng.integers(0, n // 2, nb)
+    j = rng.integers(n // 2, n, nb)
+    d = pos[j] - pos[i]
+    nrm = d / np.linalg.norm(d, axis=1)[:, None]
+    one = np.ones(nb)
+    rb, area, ib = R * rng.uniform(0.5, 1.0, nb), 1e-6 * one, 1e-13 * rng.uniform(1, 2, nb)
+    screen = bond_screen(area, rb, ib)
+    outs = []
+    for scr in (None, screen):
+        fs = np.zeros((nb, 3))
+        fs[:, :2] = 1e-3
+        arrays = [np.zeros(nb), fs, np.zeros((nb, 3)), nrm.copy(), np.zeros(nb, np.int8),
+                  np.zeros(nb, np.int8), np.zeros((nb, 9)), np.zeros((nb, 3)),
+                  np.zeros((nb, 3)), np.zeros((nb, 3))]
+        ext = [np.zeros((n, 3)), np.zeros((n, 3))]
+        nnew = 0
+        for _ in range(4):
+            extra = () if scr is None else (scr,)
+            nnew += bond_forces_2d.serial(pos, vel, omega, radius, i, j, rb, area, ib,
+                                          5e11 * one, 3e11 * one, 2e3 * one, 3e3 * one,
+                                          0.1 * one, *arrays, 1e-4, np.array([0.05, 0, 0]),
+                                          np.array([True, False, False]), True, *ext, *extra)
+        outs.append((nnew, arrays + ext))
+    (n1, a1), (n2, a2) = outs
+    assert 0 < n1 == n2 < nb
+    for x, y in zip(a1, a2, strict=True):
+        assert np.array_equal(x, y)
 
 
 def test_bad_input_is_refused() -> None:

@@ -25,7 +25,9 @@ class _General:
 
         def run(*a: Any) -> int:
             nb = a[4].shape[0]
-            return build(*a[:9], np.zeros(nb), *a[9:17], np.zeros(nb), *a[17:24], 2, *a[24:])
+            # (the general kernel has no strength screen: the 2D kernel's last argument)
+            return build(*a[:9], np.zeros(nb), *a[9:17], np.zeros(nb), *a[17:24], 2,
+                         *a[24:30])
         return run
 
 

@@ -244,13 +244,19 @@ def bond_forces(pos, vel, omega, radius, bi, bj, rb, area, ib, jb, kn, ks, tens,
 @kernel(chunk=256)
 def bond_forces_2d(pos, vel, omega, radius, bi, bj, rb, area, ib, kn, ks, tens, coh, tanphi,
                    fn, fs, mb, nrm, mode, newly, brk, fbond, tbi, tbj, dt, length, periodic,
-                   summed, ext_force, ext_torque):
+                   summed, ext_force, ext_torque, screen=None):
     """``bond_forces`` for disks (dim 2), the same operations without the terms that are
     exactly zero in the plane (z of positions, velocities, normals, shear forces, x and y
     of spins and bending moments: ``ParticleState`` fixes them, ``FIX_2D``): the same
     values as ``bond_forces`` (only the sign of zero components may differ), in about
     half the instructions. Arguments as there (no twist: no ``jb``, ``mt``, ``dim``);
-    the x and y of ``mb`` and the z of ``fs`` are left as they are (zero)."""
+    the x and y of ``mb`` and the z of ``fs`` are left as they are (zero).
+
+    ``screen`` (optional, ``bond_screen``: 1/A and Rb/I per bond): the strength test
+    first runs with these reciprocals (multiplications) and, only when a stress comes
+    within 1e-9 of its limit, as the exact divisions: a bond far from breaking (nearly
+    all) is then known intact without them. The decisions, hence the results, are the
+    same bits (the reciprocals' few-ulp error is far inside the margin)."""
     nb = bi.shape[0]
     nnew = 0
     for b in prange(nb):
@@ -298,15 +304,25 @@ def bond_forces_2d(pos, vel, omega, radius, bi, bj, rb, area, ib, kn, ks, tens, 
         mz -= kn[b] * ib[b] * ((wj2 - wi2) * dt)
         # maximum stresses (seed 000 eq 11, Potyondy & Cundall 2004), tension positive
         fsm = np.sqrt(s0 ** 2 + s1 ** 2)
-        mbm = np.sqrt(mz ** 2)
-        sig_n = -fnb / area[b]
-        sigma = sig_n + mbm * rb[b] / ib[b]
-        tau = fsm / area[b]
         how = INTACT
-        if sigma >= tens[b]:
-            how = TENSILE
-        elif tau >= coh[b] - sig_n * tanphi[b]:
-            how = SHEAR
+        exact = True
+        mbm = sig_n = sigma = tau = 0.0
+        if screen is not None:  # (a compile-time branch: None is its own type)
+            sn_a = -fnb * screen[b, 0]
+            bend_a = abs(mz) * screen[b, 1]
+            tau_a = fsm * screen[b, 0]
+            thr_a = sn_a * tanphi[b]
+            exact = not (sn_a + bend_a < tens[b] - 1e-9 * (abs(sn_a) + bend_a + tens[b])
+                         and tau_a < coh[b] - thr_a - 1e-9 * (tau_a + coh[b] + abs(thr_a)))
+        if exact:
+            mbm = np.sqrt(mz ** 2)
+            sig_n = -fnb / area[b]
+            sigma = sig_n + mbm * rb[b] / ib[b]
+            tau = fsm / area[b]
+            if sigma >= tens[b]:
+                how = TENSILE
+            elif tau >= coh[b] - sig_n * tanphi[b]:
+                how = SHEAR
         if how != INTACT:
             mode[b] = how
             newly[b] = 1
@@ -405,6 +421,7 @@ class BondStep(NamedTuple):
     fbond: np.ndarray
     tbi: np.ndarray
     tbj: np.ndarray
+    screen: np.ndarray
     dim: int
 
 
@@ -423,13 +440,18 @@ def _bond_step(s, c):  # pragma: no cover - numba
         nnew = _bonds_2d(c.pos, c.vel, c.omega, c.radius, s.i, s.j, s.rb, s.area, s.inertia,
                          s.kn, s.ks, s.tensile, s.cohesion, s.tan_phi, s.fn, s.fs, s.mb,
                          s.normal, s.mode, s.newly, s.brk, s.fbond, s.tbi, s.tbj, c.dt,
-                         c.length, c.periodic, True, c.ext_force, c.ext_torque)
+                         c.length, c.periodic, True, c.ext_force, c.ext_torque, s.screen)
     else:
         nnew = _bonds_3d(c.pos, c.vel, c.omega, c.radius, s.i, s.j, s.rb, s.area, s.inertia,
                          s.polar, s.kn, s.ks, s.tensile, s.cohesion, s.tan_phi, s.fn, s.fs,
                          s.mb, s.mt, s.normal, s.mode, s.newly, s.brk, s.fbond, s.tbi, s.tbj,
                          s.dim, c.dt, c.length, c.periodic, True, c.ext_force, c.ext_torque)
     return BONDS_BROKE if nnew else 0
+
+
+def bond_screen(area: np.ndarray, rb: np.ndarray, inertia: np.ndarray) -> np.ndarray:
+    """(nb, 2): 1/A (1/m^2) and Rb/I (1/m^3) per bond, for ``bond_forces_2d``'s screen."""
+    return np.ascontiguousarray(np.c_[1.0 / area, rb / inertia])
 
 
 def bond_csr(bi: np.ndarray, bj: np.ndarray, n: int, by_bond: bool = False
@@ -522,6 +544,7 @@ class ParallelBonds:
         self.log: list[BondBreak] = []
         self.cstart, self.cbond = bond_csr(self.i, self.j, p.n)
         self.gstart, self.gbond = bond_csr(self.i, self.j, p.n, by_bond=True)
+        self.screen = bond_screen(self.area, self.rb, self.inertia)
 
     # ------------------------------------------------------------------ interaction
     @property
@@ -549,7 +572,7 @@ class ParallelBonds:
                 self.inertia, self.kn, self.ks, self.tensile, self.cohesion, self.tan_phi,
                 self.fn, self.fs, self.mb, self.normal, self.mode, self.newly, self.brk,
                 self.fbond, self.tbi, self.tbj, sim.dt, length, sim.box.periodic,
-                summed, sim.ext_force, sim.ext_torque)
+                summed, sim.ext_force, sim.ext_torque, self.screen)
         else:
             nnew = bond_forces.pick(nb, threads)(
                 p.pos, p.vel, p.omega, p.radius, self.i, self.j, self.rb, self.area,
@@ -573,7 +596,8 @@ class ParallelBonds:
         return BondStep(self.i, self.j, self.rb, self.area, self.inertia, self.polar,
                         self.kn, self.ks, self.tensile, self.cohesion, self.tan_phi, self.fn,
                         self.fs, self.mb, self.mt, self.normal, self.mode, self.newly,
-                        self.brk, self.fbond, self.tbi, self.tbj, int(self.dim))
+                        self.brk, self.fbond, self.tbi, self.tbj, self.screen,
+                        int(self.dim))
 
     def after_compiled(self, sim: Simulation, state: BondStep) -> None:
         """Log the breaks of the compiled loop's last step (it stops after a break)."""
@@ -666,6 +690,7 @@ class ParallelBonds:
         self.brk = np.zeros((nb, N_BREAK))
         self.cstart, self.cbond = bond_csr(self.i, self.j, self.n_particles)
         self.gstart, self.gbond = bond_csr(self.i, self.j, self.n_particles, by_bond=True)
+        self.screen = bond_screen(self.area, self.rb, self.inertia)
         self.log = []
         for q in range(state["log_step"].size):
             f = {k: float(state[f"log_{k}"][q]) for k in self._LOG_F}
