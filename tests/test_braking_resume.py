@@ -76,7 +76,9 @@ def _wait_for(path: Path, proc: subprocess.Popen, timeout: float = 60.0) -> None
 def reference(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
     """(config, folder) of an uninterrupted run."""
     root = tmp_path_factory.mktemp("braking_ref")
-    cfg = _config(root)
+    # 4 us of sliding (~70k steps, about 2 s since the compiled step loop): room to be
+    # interrupted between its first checkpoint and its end
+    cfg = _config(root, duration=4e-6)
     out = root / "B"
     r = run_tribodem("braking", "run", "--config", str(cfg), "--out", str(out),
                      "--no-progress", timeout=300)
@@ -96,7 +98,7 @@ def _interrupt(cfg: Path, out: Path, sig: int) -> subprocess.CompletedProcess:
     proc = _start("braking", "run", "--config", str(cfg), "--out", str(out), "--no-progress")
     try:
         _wait_for(out / "checkpoint.npz", proc)
-        time.sleep(random.uniform(0.2, 1.2))
+        time.sleep(random.uniform(0.1, 0.8))
         assert proc.poll() is None, "the run ended before it could be interrupted"
         proc.send_signal(sig)
         stdout, stderr = proc.communicate(timeout=60)

@@ -11,7 +11,7 @@ import pytest
 
 from tribodem.braking import run as braking_run
 from tribodem.braking.model import Geometry, build_interface, start_sliding
-from tribodem.dem import Box, Material, ParticleState, PlaneWall, Simulation
+from tribodem.dem import Box, Material, ParticleState, PlaneWall, Simulation, SimulationUnstable
 from tribodem.dem.bonds import install_bonds_by_gap
 from tribodem.dem.compiled import np_sum
 
@@ -146,3 +146,18 @@ def test_braking_pieces_compiled_equal_python() -> None:
     assert a[5][1] > 0 and a[-1] > 0  # the bodies touched, bonds broke
     for x, y in zip(a, b, strict=True):
         assert np.array_equal(x, y)
+
+
+def test_instability_stops_at_the_same_step_with_the_same_message() -> None:
+    """The compiled loop's stability test (``_unstable``) stops where ``check_stability``
+    raises in the Python loop, and Python raises the same error there."""
+    msgs = []
+    for fast in (True, False):
+        sim = bed(2)
+        sim.dt *= 30.0  # far above the critical step: overlaps run away
+        sim.compiled_loop = fast
+        with pytest.raises(SimulationUnstable) as err:
+            sim.step(5000)
+        msgs.append((str(err.value), sim.step_count))
+    assert msgs[0] == msgs[1]
+    assert msgs[0][1] % 100 == 0 and "step" in msgs[0][0]

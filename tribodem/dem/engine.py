@@ -150,20 +150,44 @@ def _interactions(states, c):  # pragma: no cover - numba
     return ev
 
 
+@numba.njit(cache=True)
+def _unstable(c, max_ratio):  # pragma: no cover - numba
+    """Would ``Simulation.check_stability`` raise now? (a non-finite position or velocity;
+    else the largest overlap / smaller radius of the listed pairs above ``max_ratio``,
+    unless a ratio is NaN: numpy's argmax then picks the NaN, which passes)."""
+    for i in range(c.pos.shape[0]):
+        for k in range(3):
+            if not (np.isfinite(c.pos[i, k]) and np.isfinite(c.vel[i, k])):
+                return True
+    over = False
+    for p in range(c.pair_i.shape[0]):
+        ri = c.radius[c.pair_i[p]]
+        rj = c.radius[c.pair_j[p]]
+        ratio = c.pinfo[p, 0] / (ri if ri < rj else rj)
+        if ratio != ratio or ri != ri or rj != rj:  # np.minimum keeps a NaN radius
+            return False
+        if ratio > max_ratio:
+            over = True
+    return over
+
+
 #: why ``_run_steps`` returned: the steps asked for are done, a neighbour rebuild is due
-#: before the next step, or an interaction's step function reported an event
-RUN_DONE, RUN_REBUILD, RUN_EVENT = 0, 1, 2
+#: before the next step, an interaction's step function reported an event, or the
+#: stability check failed (``Simulation.check_stability`` then raises)
+RUN_DONE, RUN_REBUILD, RUN_EVENT, RUN_UNSTABLE = 0, 1, 2, 3
 
 
 @numba.njit(cache=True)
-def _run_steps(c, states, nmax):  # pragma: no cover - numba
+def _run_steps(c, states, nmax, step0, check_every, max_ratio):  # pragma: no cover
     """Up to ``nmax`` steps of ``Simulation.step`` in one compiled loop (serial kernels,
     the same operations in the same order, so the same bits): pair contacts -> the
     interactions' compiled steps (``states``, in order) -> wall pass and the walls'
     totals -> particle update -> wall motion -> clock. The first step starts at once (the
     caller has just checked the neighbour list); before each later one the rebuild test
-    runs and, if due, the loop stops. Returns (steps done, ``RUN_*`` reason, the OR of
-    the interactions' event codes)."""
+    runs and, if due, the loop stops. After every step whose count (from ``step0``) is a
+    multiple of ``check_every`` the stability test runs (``_unstable``) and stops the
+    loop if it fails. Returns (steps done, ``RUN_*`` reason, the OR of the interactions'
+    event codes)."""
     nw = c.wall_point.shape[0]
     n = c.pos.shape[0]
     k = 0
@@ -216,6 +240,9 @@ def _run_steps(c, states, nmax):  # pragma: no cover - numba
         if ev:
             events |= ev
             why = RUN_EVENT
+            break
+        if (step0 + k) % check_every == 0 and _unstable(c, max_ratio):
+            why = RUN_UNSTABLE
             break
     c.clock[0] = t
     return k, why, events
@@ -602,16 +629,17 @@ class Simulation:
 
     def _compiled_run(self, states: tuple, nmax: int) -> int:
         """Steps in the compiled loop (``_run_steps``), at most ``nmax``, up to the next
-        event: a neighbour rebuild, an interaction's event, a stability check or a
-        recorder sample (those run here, in Python, as in ``_python_step``). Returns the
-        steps done (>= 1)."""
+        event: a neighbour rebuild, an interaction's event, a failed stability check or a
+        recorder sample (those run here, in Python, as in ``_python_step``; a passed
+        check needs no return). Returns the steps done (>= 1)."""
         self._refresh_walls()
         self._maybe_rebuild()
-        limit = min(nmax, self.check_every - self.step_count % self.check_every)
+        limit = nmax
         for every, _ in self.recorders:
             limit = min(limit, every - self.step_count % every)
         c = self._context()
-        k, _why, _events = _run_steps(c, states, limit)
+        k, _why, _events = _run_steps(c, states, limit, self.step_count, self.check_every,
+                                      self.max_overlap_ratio)
         self._summed = True
         self._evaluated = True
         rows = c.wall_tot.tolist()
