@@ -174,6 +174,7 @@ class _Loop:
         self.contact = np.zeros(3)
         self.speed_steps, self.speed = speed_ramp_steps, speed
         self.distance = 0.0  # m slid by the disc's anchored layer
+        self._buf = np.zeros(1)  # the compiled form's interface-force buffer (N)
         self.apply()
 
     def apply(self) -> None:
@@ -207,8 +208,8 @@ class _Loop:
         back = self.iface.backing
         reaction = back._out if back is not None else np.zeros(1)
         m = sim.nl.n_pairs
-        if getattr(self, "_buf", None) is None or self._buf.shape[0] < m:
-            self._buf = np.zeros(max(m, 1))
+        if self._buf.shape[0] < m:
+            self._buf = np.zeros(m)
         return LoopStep(wall_index(sim, self.iface.wall), back is not None, reaction,
                         np.array([self.total, self.distance]), np.array([self.n]),
                         self.contact, float(self.full), float(self.speed), CONTACT_EVERY,

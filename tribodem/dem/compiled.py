@@ -23,8 +23,11 @@ the step and returns to Python, where ``after_compiled`` sees the event. The eng
 dispatches to the step function by the state's class (:func:`interaction_step`, a numba
 overload), so the engine knows no application.
 
-Numba's disk cache keys the loop by its own source file: after editing a registered step
-function, clear the loop's cache (``tribodem/dem/__pycache__/engine._run_steps*``).
+Numba's disk cache checks a compiled function against its own source file only, and the
+loop links the registered steps (and every kernel's helpers) from other files: after
+editing one of them, delete ``tribodem/**/__pycache__/*.nbi`` and ``*.nbc`` (else the old
+code keeps running; a fresh clone has no cache). The first call compiles the loop once per
+set of state classes (seconds); it is cached after that.
 """
 
 from __future__ import annotations
