@@ -235,20 +235,27 @@ def test_threaded_and_serial_kernels_agree_bitwise() -> None:
     assert np.any(outs[0][1][-2] != 0.25)
 
 
-def test_2d_kernel_matches_the_general_one() -> None:
-    """Disks: ``bond_forces_2d`` gives the general kernel's values (== equality, so only
-    the sign of zeros may differ) on serial summed and threaded stored passes, over
-    several steps with breaks."""
-    rng = np.random.default_rng(5)
-    n, nb = 2000, 4500
-    pos = np.c_[rng.uniform(0, 0.1, (n, 2)), np.zeros(n)]
+def _disk_bonds(rng: np.random.Generator, n: int, nb: int, box: float) -> tuple:
+    """``n`` random disks in a ``box`` (m) square moving and spinning, ``nb`` random bonds
+    (i in the first half, j in the second) and their unit normals: (pos, vel, omega,
+    radius, i, j, normal)."""
+    pos = np.c_[rng.uniform(0, box, (n, 2)), np.zeros(n)]
     vel = np.c_[rng.normal(0, 1e-3, (n, 2)), np.zeros(n)]
     omega = np.c_[np.zeros((n, 2)), rng.normal(0, 1e-1, n)]
     radius = rng.uniform(0.8, 1.2, n) * R
     i = rng.integers(0, n // 2, nb)
     j = rng.integers(n // 2, n, nb)
     d = pos[j] - pos[i]
-    nrm = d / np.linalg.norm(d, axis=1)[:, None]
+    return pos, vel, omega, radius, i, j, d / np.linalg.norm(d, axis=1)[:, None]
+
+
+def test_2d_kernel_matches_the_general_one() -> None:
+    """Disks: ``bond_forces_2d`` gives the general kernel's values (== equality, so only
+    the sign of zeros may differ) on serial summed and threaded stored passes, over
+    several steps with breaks."""
+    rng = np.random.default_rng(5)
+    n, nb = 2000, 4500
+    pos, vel, omega, radius, i, j, nrm = _disk_bonds(rng, n, nb, 0.1)
     nrm[:, :2] += rng.normal(0, 1e-3, (nb, 2))  # the normal turned since the last step
     one = np.ones(nb)
     length, periodic = np.array([0.1, 0.0, 0.0]), np.array([True, False, False])
@@ -292,14 +299,7 @@ def test_2d_screen_gives_the_same_bits() -> None:
     near a limit) decides every bond as without it: the same arrays, the same breaks."""
     rng = np.random.default_rng(8)
     n, nb = 600, 1500
-    pos = np.c_[rng.uniform(0, 0.05, (n, 2)), np.zeros(n)]
-    vel = np.c_[rng.normal(0, 1e-3, (n, 2)), np.zeros(n)]
-    omega = np.c_[np.zeros((n, 2)), rng.normal(0, 1e-1, n)]
-    radius = rng.uniform(0.8, 1.2, n) * R
-    i = rng.integers(0, n // 2, nb)
-    j = rng.integers(n // 2, n, nb)
-    d = pos[j] - pos[i]
-    nrm = d / np.linalg.norm(d, axis=1)[:, None]
+    pos, vel, omega, radius, i, j, nrm = _disk_bonds(rng, n, nb, 0.05)
     one = np.ones(nb)
     rb, area, ib = R * rng.uniform(0.5, 1.0, nb), 1e-6 * one, 1e-13 * rng.uniform(1, 2, nb)
     screen = bond_screen(area, rb, ib)

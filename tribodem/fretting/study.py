@@ -121,10 +121,9 @@ def compare(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
         for q, seed in nums.items():
             ran = r is not None and not r.get("skipped") and r.get("cycles") != 0
             ours = r.get(q) if ran else None
-            ratio = ours / seed if ours is not None and seed and math.isfinite(ours) else None
-            bound = (stage, q) in SEED_LOWER_BOUNDS
-            if bound and ours is not None and ours == math.inf:
-                ratio = math.inf
+            bound = (stage, q) in SEED_LOWER_BOUNDS  # an infinite value meets a bound
+            ratio = (ours / seed if ours is not None and seed
+                     and (math.isfinite(ours) or (bound and ours > 0)) else None)
             agree = None if ratio is None else (ratio >= 1.0 if bound else abs(ratio - 1) <= 0.2)
             out.append({"stage": stage, "quantity": q, "seed": seed, "ours": ours,
                         "ratio": ratio, "seed_is_lower_bound": bound, "within_20pct": agree})
