@@ -271,16 +271,22 @@ class FirstBodySolver(ABC):
         """Depth of the grid on which plastic strain is solved, m."""
         raise Unsupported(f"{type(self).__name__} gives no plastic strain")
 
-    # -- debris third body (capability ``debris``)
+    # -- debris third body (capability ``debris``): a backend that takes a debris pressure
+    # keeps it in these two attributes (``set_debris_pressure``), read by the properties
+    _debris_pressure: NDArray[np.float64] | None = None
+    _debris_load: float = 0.0
+
     @property
     def debris_pressure(self) -> NDArray[np.float64]:
         """The prescribed debris pressure on the window, Pa [n, n] (zeros when none)."""
-        return np.zeros((self.n, self.n))
+        if self._debris_pressure is None:
+            return np.zeros((self.n, self.n))
+        return self._debris_pressure
 
     @property
     def debris_load(self) -> float:
         """Load carried by the debris, N."""
-        return 0.0
+        return self._debris_load
 
     def set_debris_pressure(self, pressure: NDArray[np.float64] | None) -> None:
         """Prescribe the debris pressure, Pa [n, n] (None clears)."""

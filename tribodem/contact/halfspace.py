@@ -275,16 +275,6 @@ class HalfSpaceSolver(FirstBodySolver):
         self._debris_load = float(state["debris_load"])
         self._debris_u = np.array(state["debris_u"], dtype=float)
 
-    @property
-    def debris_pressure(self) -> NDArray[np.float64]:
-        """The prescribed debris pressure, Pa [n, n] (zeros when none)."""
-        return self._debris_pressure
-
-    @property
-    def debris_load(self) -> float:
-        """Load carried by the debris, N."""
-        return self._debris_load
-
     def set_debris_pressure(self, pressure: NDArray[np.float64] | None) -> None:
         """Prescribe the debris (third-body) pressure on the window, Pa [n, n] (None clears).
 

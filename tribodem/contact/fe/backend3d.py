@@ -450,7 +450,7 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         self._peeq_cache: dict[tuple[str, str, float], NDArray[np.float64]] = {}
         self._pending: list[PlasticStep] = []
         self.cycle_reports: list[dict[str, Any]] = []  #: :meth:`_cycle_report` per job
-        self._debris = np.zeros((self.n, self.n))  # prescribed debris pressure, Pa
+        self._debris_pressure = np.zeros((self.n, self.n))  # prescribed debris pressure, Pa
         self._debris_load = 0.0
         self.mesh: Mesh3D = self._mesh0  #: the (morphed) mesh of the last job
 
@@ -676,23 +676,14 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
 
     def _key(self) -> tuple[bytes, ...]:
         """The geometry, the debris pressure and the priming a job was run with."""
-        return (*super()._key(), self._debris.tobytes(), b"primed" if self._primed() else b"")
+        return (*super()._key(), self._debris_pressure.tobytes(),
+                b"primed" if self._primed() else b"")
 
     def _primed(self) -> bool:
         """Whether the next job primes its cycle (mode ``primed``, from the second cycle)."""
         return self.mode == "primed" and self._cycle >= 1
 
     # -- debris third body (seed 003 section 3.2.7: forces mapped back) --------------------
-    @property
-    def debris_pressure(self) -> NDArray[np.float64]:
-        """The prescribed debris pressure on the window, Pa [n, n] (zeros when none)."""
-        return self._debris
-
-    @property
-    def debris_load(self) -> float:
-        """Load carried by the debris, N."""
-        return self._debris_load
-
     def set_debris_pressure(self, pressure: NDArray[np.float64] | None) -> None:
         """Prescribe the debris pressure on the window (the upper body's frame at offset 0),
         Pa [n, n] (None clears). The next job loads both contact faces with it, as a face
@@ -702,11 +693,11 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         carries ``load - debris_load``. Kept until cleared (``reset`` keeps it too)."""
         n = self.n
         if pressure is None:
-            self._debris = np.zeros((n, n))
+            self._debris_pressure = np.zeros((n, n))
             self._debris_load = 0.0
             return
-        self._debris, self._debris_load = checked_debris_pressure(pressure, n, self.dx,
-                                                                  self.load)
+        self._debris_pressure, self._debris_load = checked_debris_pressure(
+            pressure, n, self.dx, self.load)
 
     def _debris_at(self, x: NDArray[np.float64], y: NDArray[np.float64]
                    ) -> NDArray[np.float64]:
@@ -714,7 +705,8 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         from scipy.interpolate import RegularGridInterpolator
 
         c = self.coords
-        f = RegularGridInterpolator((c, c), self._debris, bounds_error=False, fill_value=0.0)
+        f = RegularGridInterpolator((c, c), self._debris_pressure, bounds_error=False,
+                                    fill_value=0.0)
         return f(np.stack([x, y], axis=-1))
 
     def _debris_face_loads(self, mesh: Mesh3D) -> dict[str, tuple[NDArray[np.int64],
@@ -757,9 +749,9 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         minus the lower surface's at the same (x, y), both displaced."""
         if float(offset) != 0.0:
             raise ValueError(f"offset = {offset!r}: the fe3d loaded solution is at offset 0")
-        keep = (self._debris, self._debris_load)
+        keep = (self._debris_pressure, self._debris_load)
         if not debris:
-            self._debris, self._debris_load = np.zeros((self.n, self.n)), 0.0
+            self._debris_pressure, self._debris_load = np.zeros((self.n, self.n)), 0.0
         try:
             if self._key() != self._job_key or not self._served:
                 self._run_job()
@@ -768,14 +760,14 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
             assert self._loaded_result is not None
             p = self._loaded_result.pressure.copy()
         finally:
-            self._debris, self._debris_load = keep
+            self._debris_pressure, self._debris_load = keep
         up = self.mesh.nodes[self._cols["upper"][..., 0]] + st["u_up"]
         lo = self.mesh.nodes[self._cols["lower"][..., 0]] + st["u_lo"]
         z_lo = _bilinear(self._xl, self._ys, lo[..., 2][..., None],
                          up[..., 0].ravel(), np.abs(up[..., 1]).ravel())[:, 0]
         gap = np.maximum(up[..., 2] - z_lo.reshape(up.shape[:2]), 0.0)
         gap_w = self._window(gap, 1.0, False)
-        return (p + self._debris if debris else p), gap_w
+        return (p + self._debris_pressure if debris else p), gap_w
 
     def _start_cycle(self) -> None:
         if not (self._key() == self._job_key and self._served and self._fresh_for_cycle):
@@ -1209,7 +1201,7 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         whether the bodies were loaded, the mode and the work folder."""
         return {"cycle": self._cycle, "loaded": self._loaded, "mode": self.mode,
                 "material": self.material, "cycle_reports": list(self.cycle_reports),
-                "debris_pressure": self._debris.copy(), "debris_load": self._debris_load,
+                "debris_pressure": self._debris_pressure.copy(), "debris_load": self._debris_load,
                 "workdir": None if self.workdir is None else str(self.workdir)}
 
     def load_state_dict(self, state: dict[str, Any]) -> None:
@@ -1228,7 +1220,7 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         self._pending = []
         self.cycle_reports = list(state.get("cycle_reports", []))
         if "debris_pressure" in state:
-            self._debris = np.array(state["debris_pressure"], dtype=float)
+            self._debris_pressure = np.array(state["debris_pressure"], dtype=float)
             self._debris_load = float(state["debris_load"])
         if self.workdir is None and state.get("workdir"):
             self.workdir = Path(state["workdir"])
