@@ -126,6 +126,25 @@ def test_cli_calibrate_quick(tmp_path: Path) -> None:
     assert abs(s["E_rel_error"]) <= TOLERANCE and abs(s["nu_rel_error"]) <= TOLERANCE
     assert s["E_rel_error"] == pytest.approx((s["E_Pa"] - 201e9) / 201e9)
     assert (out / "stress_strain.png").stat().st_size > 10_000
+    # the default ran one task per specimen on a local Dask cluster; in this process
+    # (--workers 1) the same packings and tests give the same numbers to the last bit
+    assert s["ran_on"].startswith("local Dask cluster")
+    one = tmp_path / "one"
+    r = tribodem("calibrate", "--material", "q345b", "--out", str(one), "--quick",
+                 "--workers", "1", "--no-progress")
+    assert r.returncode == 0, r.stderr
+    s1 = json.loads((one / "summary.json").read_text())
+    assert s1["ran_on"] == "this process"
+    for key in ("E_Pa", "nu", "history", "per_specimen", "calibrated_micro_parameters"):
+        assert s1[key] == s[key], key
+
+
+def test_cli_calibrate_workers_with_scheduler_exit_2(tmp_path: Path) -> None:
+    r = tribodem("calibrate", "--material", "q345b", "--out", str(tmp_path / "o"),
+                 "--workers", "2", "--scheduler", "tcp://127.0.0.1:1")
+    assert r.returncode == 2
+    assert "--workers = 2" in r.stderr and "--scheduler" in r.stderr
+    assert "Traceback" not in r.stderr and not (tmp_path / "o").exists()
 
 
 def test_cli_bad_material_exit_2(tmp_path: Path) -> None:

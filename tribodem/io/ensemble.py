@@ -2,7 +2,8 @@
 
 Used by ``tribodem braking sweep`` (:mod:`tribodem.braking.ensemble`) and ``tribodem
 fretting sweep`` (:mod:`tribodem.fretting.sweep`); each of them says what a member is and
-what its task does, this module runs the tasks:
+what its task does, this module runs the tasks (and, for short tasks without folders such
+as ``tribodem calibrate``'s specimens, maps a function over items: :func:`task_map`):
 
 - by default on a ``LocalCluster`` of worker *processes* with one thread each (``--workers``,
   default all local cores), every worker with numba, OpenMP and BLAS limited to one thread
@@ -33,7 +34,8 @@ import logging
 import os
 import time
 import uuid
-from collections.abc import Callable, Hashable, Sequence
+from collections.abc import Callable, Hashable, Iterator, Sequence
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any, Protocol
 
@@ -144,9 +146,12 @@ def open_client(scheduler: str | None, workers: int) -> tuple[Any, Any]:
     n = workers or local_cores()
     with dask.config.set({"distributed.scheduler.worker-saturation": 1.0,
                           "distributed.worker.daemon": True}):
+        # no dashboard; the scheduler's HTTP server (health routes) on a free port: its
+        # default 8787 warns on stderr when another cluster holds it
         cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                               dashboard_address=None, silence_logs=logging.CRITICAL,
-                               env=dict(WORKER_ENV))
+                               dashboard_address="127.0.0.1:0",
+                               scheduler_kwargs={"dashboard": False},
+                               silence_logs=logging.CRITICAL, env=dict(WORKER_ENV))
     try:
         client = Client(cluster, set_as_default=False)
     except BaseException:
@@ -262,3 +267,69 @@ def run_members(todo: Sequence[Member], total: int, done_before: int, *,
         raise
     close(client, cluster)
     return results, failed, where
+
+
+#: ``map_(fn, items, on_done)``: ``[fn(x) for x in items]`` in order, ``on_done()`` after
+#: each item finishes (in the order they finish)
+Mapper = Callable[[Callable[[Any], Any], Sequence[Any], Callable[[], None] | None], list[Any]]
+
+
+def serial_map(fn: Callable[[Any], Any], items: Sequence[Any],
+               on_done: Callable[[], None] | None = None) -> list[Any]:
+    """A :data:`Mapper` in this process, one item after another."""
+    out = []
+    for x in items:
+        out.append(fn(x))
+        if on_done is not None:
+            on_done()
+    return out
+
+
+def one_thread_on_worker() -> None:
+    """Inside a Dask worker: numba limited to one thread (a remote worker's environment is
+    not ours, so :data:`WORKER_ENV` may not hold there); elsewhere nothing."""
+    try:
+        from distributed import get_worker
+
+        get_worker()
+    except (ImportError, ValueError):
+        return
+    import numba
+
+    numba.set_num_threads(1)
+
+
+@contextmanager
+def task_map(scheduler: str | None, workers: int) -> Iterator[Mapper]:
+    """A :data:`Mapper` on Dask: a ``LocalCluster`` of ``workers`` one-thread processes (0 =
+    all local cores) or the cluster at ``scheduler`` (:func:`open_client`). For tasks
+    whose results are small enough to return (no member folders, nothing to resume): the
+    first failed task raises its error. On Ctrl-C or any error the local workers are
+    killed, the tasks cancelled and the client closed before the error goes on."""
+    from distributed import as_completed
+
+    client, cluster = open_client(scheduler, workers)
+    pids = list(client.run(os.getpid).values()) if cluster is not None else []
+    submitted: list[Any] = []
+
+    def map_(fn: Callable[[Any], Any], items: Sequence[Any],
+             on_done: Callable[[], None] | None = None) -> list[Any]:
+        futs = [client.submit(fn, x, pure=False) for x in items]
+        submitted.extend(futs)
+        for f in as_completed(futs, loop=client.loop):
+            f.result()  # a failure raises here, at once
+            if on_done is not None:
+                on_done()
+        return [f.result() for f in futs]
+
+    try:
+        yield map_
+    except BaseException:
+        _kill(pids)
+        try:
+            client.cancel(submitted, force=True)
+        except Exception:  # noqa: BLE001 - best effort
+            pass
+        close(client, cluster)
+        raise
+    close(client, cluster)

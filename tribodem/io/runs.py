@@ -63,6 +63,8 @@ def where() -> str:
     c = _current
     if c.out is None:
         return ""
+    if not c.out.exists():  # stopped before its first file (e.g. calibrate writes at the end)
+        return f"no outputs were written yet (they go to '{c.out}')"
     text = f"outputs so far are in '{c.out}'"
     if c.checkpoint is not None and c.checkpoint.exists():
         text += f"; last checkpoint '{c.checkpoint}'"

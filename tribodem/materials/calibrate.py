@@ -12,6 +12,10 @@ and nu are driven to the targets of table 1:
   with kratio; first slope 0.2 per unit log), steps capped at a factor 3, kratio kept in
   ``KRATIO_RANGE``.
 
+The specimens are packed, and each iteration's compression tests run, through a mapper
+(:mod:`tribodem.io.ensemble`: in this process, or one task per specimen on Dask with
+``tribodem calibrate --workers/--scheduler``): the same results either way.
+
 Stops when ``|E - E_t| / E_t <= tol`` and ``|nu - nu_t| / nu_t <= tol`` (tol 2.6%, the
 largest error of the seed's table 2) or after ``max_iter`` tests. Bond strengths are not
 calibrated: they only move the peak, not E or nu.
@@ -26,6 +30,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from tribodem.io.ensemble import Mapper, one_thread_on_worker, serial_map
 from tribodem.materials.compression import CompressionResult, run_compression
 from tribodem.materials.library import MaterialSpec
 from tribodem.materials.specimen import Specimen, make_specimen
@@ -54,16 +59,29 @@ class CalibrationResult:
     notes: list[str] = field(default_factory=list)
 
 
+def _specimen_task(args: tuple[MaterialSpec, float, float, int]) -> Specimen:
+    """Pack one specimen (a task: (spec, width m, height m, seed))."""
+    one_thread_on_worker()
+    spec, width, height, seed = args
+    return make_specimen(spec, width, height, seed=seed)
+
+
+def _compression_task(args: tuple[Specimen, MaterialSpec, dict[str, float]]
+                      ) -> CompressionResult:
+    """Re-bond one specimen with a spec and compress it (a task: (specimen, spec, keywords
+    of ``run_compression``))."""
+    one_thread_on_worker()
+    specimen, spec, kw = args
+    return run_compression(specimen.with_spec(spec), **kw)  # type: ignore[arg-type]
+
+
 def measure(specimens: list[Specimen], spec: MaterialSpec,
-            on_test: Callable[[], None] | None = None, **kw: float
-            ) -> tuple[float, float, list[CompressionResult]]:
+            on_test: Callable[[], None] | None = None, map_: Mapper = serial_map,
+            **kw: float) -> tuple[float, float, list[CompressionResult]]:
     """Mean E (Pa) and nu over the specimens re-bonded with ``spec`` (eq 12); ``on_test``
-    is called after each specimen's test."""
-    res = []
-    for s in specimens:
-        res.append(run_compression(s.with_spec(spec), **kw))  # type: ignore[arg-type]
-        if on_test is not None:
-            on_test()
+    is called after each specimen's test; ``map_`` runs the tests (in order of the
+    specimens; :mod:`tribodem.io.ensemble`)."""
+    res = map_(_compression_task, [(s, spec, kw) for s in specimens], on_test)
     return (float(np.mean([r.young for r in res])), float(np.mean([r.poisson for r in res])),
             res)
 
@@ -71,11 +89,14 @@ def measure(specimens: list[Specimen], spec: MaterialSpec,
 def calibrate(spec: MaterialSpec, n_specimens: int = 3, seed: int = 0, tol: float = TOLERANCE,
               max_iter: int = 12, width: float = SPECIMEN_WIDTH,
               height: float = SPECIMEN_HEIGHT, platen_speed: float = 0.1,
-              on_test: Callable[[], None] | None = None) -> CalibrationResult:
+              on_test: Callable[[], None] | None = None, map_: Mapper = serial_map
+              ) -> CalibrationResult:
     """Adjust E_c and kratio of ``spec`` until E and nu are within ``tol`` of its targets.
 
     ``on_test``: called after every compression test (``n_specimens`` per iteration, at
-    most ``max_iter`` iterations), e.g. to advance a progress bar."""
+    most ``max_iter`` iterations), e.g. to advance a progress bar. ``map_``: runs the
+    packings and each iteration's tests (:mod:`tribodem.io.ensemble`; on Dask: one task
+    per specimen)."""
     if not n_specimens >= 1:
         raise ValueError(f"calibrate: n_specimens = {n_specimens!r}: must be >= 1")
     if not 0 < tol < 1:
@@ -83,7 +104,8 @@ def calibrate(spec: MaterialSpec, n_specimens: int = 3, seed: int = 0, tol: floa
     if not max_iter >= 1:
         raise ValueError(f"calibrate: max_iter = {max_iter!r}: must be >= 1")
     t0 = time.perf_counter()
-    specimens = [make_specimen(spec, width, height, seed=seed + k) for k in range(n_specimens)]
+    specimens = map_(_specimen_task, [(spec, width, height, seed + k)
+                                      for k in range(n_specimens)], None)
     cur = spec
     history: list[dict[str, float]] = []
     slope = 0.2  # d nu / d ln(kratio), first guess (measured 0.15-0.25)
@@ -92,7 +114,7 @@ def calibrate(spec: MaterialSpec, n_specimens: int = 3, seed: int = 0, tol: floa
     best: tuple[float, MaterialSpec, float, float, list[CompressionResult]] | None = None
     converged = False
     for it in range(1, max_iter + 1):
-        young, nu, res = measure(specimens, cur, on_test, platen_speed=platen_speed)
+        young, nu, res = measure(specimens, cur, on_test, map_, platen_speed=platen_speed)
         e_err = (young - spec.young) / spec.young
         n_err = (nu - spec.poisson) / spec.poisson
         history.append({"iteration": it, "effective_modulus_Pa": cur.effective_modulus,

@@ -34,12 +34,30 @@ def calibrate(
     quick: bool = typer.Option(False, "--quick",
                                help=f"{QUICK_SPECIMENS} specimens instead of {FULL_SPECIMENS}."),
     seed: int = typer.Option(0, "--seed", min=0, help="First specimen seed."),
+    specimens: int | None = typer.Option(
+        None, "--specimens", min=1, max=10000,
+        help=f"Specimens (packings) per iteration; default {FULL_SPECIMENS} "
+             f"({QUICK_SPECIMENS} with --quick)."),
+    workers: int = typer.Option(
+        0, "--workers", min=0, max=1024,
+        help="Worker processes of a local Dask cluster (1 thread each), one specimen per "
+             "task; 0 = all local cores; 1 = in this process, no cluster. Not with "
+             "--scheduler."),
+    scheduler: str | None = typer.Option(
+        None, "--scheduler", help="Use an existing Dask cluster: tcp://HOST:PORT of its "
+        "scheduler or its scheduler JSON file."),
     progress: bool = typer.Option(True, "--progress/--no-progress",
                                   help="Progress bar (compression tests) with ETA on stderr."),
 ) -> None:
     """Calibrate E_c and kratio by uniaxial compression (seed 000 eq 12) to table 1's E, nu:
-    writes summary.json, history.csv and stress_strain.png."""
+    writes summary.json, history.csv and stress_strain.png.
+
+    The specimens are packed and each iteration's compression tests run one task per
+    specimen on Dask (the same results on any number of workers)."""
+    from contextlib import nullcontext
+
     from tribodem.io import runs
+    from tribodem.io.ensemble import check_scheduler, serial_map, task_map
     from tribodem.materials.calibrate import TOLERANCE
     from tribodem.materials.calibrate import calibrate as run_calibration
     from tribodem.materials.compression import plot_stress_strain
@@ -50,15 +68,23 @@ def calibrate(
         raise ConfigError(f"calibrate: --material = {material!r}: must be one of "
                           f"{sorted(LIBRARY)}")
     spec = LIBRARY[key]
+    if scheduler is not None and workers:
+        raise ConfigError(f"calibrate: --workers = {workers}: sets the local cluster's size, "
+                          "so it cannot go with --scheduler (the cluster there has its own "
+                          "workers); allowed: one of the two")
+    if scheduler is not None:
+        check_scheduler(scheduler)
     runs.check_out_dir(out, "--out")
     runs.announce(out)
-    n = QUICK_SPECIMENS if quick else FULL_SPECIMENS
+    n = specimens if specimens is not None else (QUICK_SPECIMENS if quick else FULL_SPECIMENS)
+    local = scheduler is None and workers == 1
     max_iter = QUICK_MAX_ITER if quick else FULL_MAX_ITER
     # one step per compression test; the total is the most the calibration may need
     # (n specimens x max_iter iterations): it usually converges earlier
-    with runs.progress(n * max_iter, "test", f"calibrate {key}", enabled=progress) as bar:
+    with (runs.progress(n * max_iter, "test", f"calibrate {key}", enabled=progress) as bar,
+          nullcontext(serial_map) if local else task_map(scheduler, workers) as map_):
         res = run_calibration(spec, n_specimens=n, seed=seed, max_iter=max_iter,
-                              on_test=lambda: bar.update(1))
+                              on_test=lambda: bar.update(1), map_=map_)
         if hasattr(bar, "refresh"):  # converged early: end the bar where it is
             bar.total = bar.n
             bar.refresh()
@@ -66,6 +92,8 @@ def calibrate(
     ns = [p["nu"] for p in res.per_specimen]
     summary = {
         "material": spec.name, "quick": quick, "seed": seed, "specimens": n,
+        "ran_on": ("this process" if local else scheduler or
+                   f"local Dask cluster, {workers or 'all'} worker(s)"),
         "E_Pa": res.young, "nu": res.poisson, "E_target_Pa": spec.young,
         "nu_target": spec.poisson, "E_rel_error": res.young_error,
         "nu_rel_error": res.poisson_error, "tolerance": TOLERANCE,
