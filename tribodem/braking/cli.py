@@ -390,7 +390,7 @@ def braking_sweep(
     from tribodem.braking.compare import write_comparison
     from tribodem.braking.ensemble import member_plan
     from tribodem.io import runs
-    from tribodem.io.ensemble import check_scheduler, run_members
+    from tribodem.io.ensemble import check_cluster_options, run_members
     from tribodem.io.runs import RunStopped
 
     if seeds is not None:
@@ -401,12 +401,7 @@ def braking_sweep(
                               f"--packings) contradicts --packings = {packings}; allowed: "
                               "give --packings only")
     n_pack = packings or seeds or 1
-    if scheduler is not None and workers:
-        raise ConfigError(f"braking sweep: --workers = {workers}: sets the local cluster's "
-                          "size, so it cannot go with --scheduler (the cluster there has "
-                          "its own workers); allowed: one of the two")
-    if scheduler is not None:
-        check_scheduler(scheduler)
+    check_cluster_options("braking sweep", workers, scheduler)
     base = _config(None, config, quick).model_dump()
     base["condition"] = {}
     t0 = time.perf_counter()

@@ -56,7 +56,7 @@ from tribodem.fretting.cli import (
 from tribodem.fretting.output import CHECKPOINT, read_checkpoint
 from tribodem.io import runs
 from tribodem.io.config import ConfigError, load_toml, merge, validate
-from tribodem.io.ensemble import check_scheduler, run_members
+from tribodem.io.ensemble import check_cluster_options, run_members
 from tribodem.io.results import write_csv, write_json
 
 #: sweep.csv / sweep.json column <- summary.json entry, in this order
@@ -365,12 +365,7 @@ def run_sweep(table: Path, out: Path, config: Path | None, quick: bool, workers:
               ) -> dict[str, Any]:
     """The whole command: check everything, run the members not finished, write
     sweep.csv / sweep.json; raise ``RunStopped`` when a member failed or stopped."""
-    if scheduler is not None and workers:
-        raise ConfigError(f"fretting sweep: --workers = {workers}: sets the local cluster's "
-                          "size, so it cannot go with --scheduler (the cluster there has "
-                          "its own workers); allowed: one of the two")
-    if scheduler is not None:
-        check_scheduler(scheduler)
+    check_cluster_options("fretting sweep", workers, scheduler)
     t0 = time.perf_counter()
     columns, todo_all = members(table, out, config, quick)
     runs.check_out_dir(out, "--out")  # every member checked first: no folder for a bad one

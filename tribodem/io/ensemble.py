@@ -127,6 +127,18 @@ def check_scheduler(scheduler: str) -> dict[str, str]:
                       "file")
 
 
+def check_cluster_options(command: str, workers: int, scheduler: str | None) -> None:
+    """``--workers`` (a local cluster's size) and ``--scheduler`` (an existing cluster)
+    exclude each other; the scheduler must look like one (:func:`check_scheduler`).
+    ``ConfigError`` naming ``command``, the option and the value otherwise."""
+    if scheduler is not None and workers:
+        raise ConfigError(f"{command}: --workers = {workers}: sets the local cluster's size, "
+                          "so it cannot go with --scheduler (the cluster there has its own "
+                          "workers); allowed: one of the two")
+    if scheduler is not None:
+        check_scheduler(scheduler)
+
+
 def open_client(scheduler: str | None, workers: int) -> tuple[Any, Any]:
     """(client, local cluster or None): a ``LocalCluster`` of ``workers`` processes (0 =
     all local cores) with one thread each, or a client of the cluster at ``scheduler``

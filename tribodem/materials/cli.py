@@ -57,7 +57,7 @@ def calibrate(
     from contextlib import nullcontext
 
     from tribodem.io import runs
-    from tribodem.io.ensemble import check_scheduler, serial_map, task_map
+    from tribodem.io.ensemble import check_cluster_options, serial_map, task_map
     from tribodem.materials.calibrate import TOLERANCE
     from tribodem.materials.calibrate import calibrate as run_calibration
     from tribodem.materials.compression import plot_stress_strain
@@ -68,12 +68,7 @@ def calibrate(
         raise ConfigError(f"calibrate: --material = {material!r}: must be one of "
                           f"{sorted(LIBRARY)}")
     spec = LIBRARY[key]
-    if scheduler is not None and workers:
-        raise ConfigError(f"calibrate: --workers = {workers}: sets the local cluster's size, "
-                          "so it cannot go with --scheduler (the cluster there has its own "
-                          "workers); allowed: one of the two")
-    if scheduler is not None:
-        check_scheduler(scheduler)
+    check_cluster_options("calibrate", workers, scheduler)
     runs.check_out_dir(out, "--out")
     runs.announce(out)
     n = specimens if specimens is not None else (QUICK_SPECIMENS if quick else FULL_SPECIMENS)
