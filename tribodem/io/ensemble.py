@@ -203,6 +203,34 @@ def _running(client: Any, keys: set[str]) -> int:
         return 0
 
 
+@contextmanager
+def _session(scheduler: str | None, workers: int, futures: Callable[[], list[Any]],
+             on_stop: Callable[[Any], None] | None = None) -> Iterator[tuple[Any, bool]]:
+    """(client, whether the cluster is our local one) for the body of a ``with``; the
+    client and the local cluster are closed after it. On Ctrl-C or any error in the body:
+    our local workers killed at once (every file a task writes is atomic), ``on_stop``
+    (client) called, the tasks ``futures()`` cancelled, client and cluster closed, the
+    error re-raised."""
+    client, cluster = open_client(scheduler, workers)
+    pids: list[int] = []
+    try:
+        if cluster is not None:  # our own workers: killed at once on a stop
+            pids = list(client.run(os.getpid).values())
+        yield client, cluster is not None
+    except BaseException:
+        _kill(pids)
+        for stop in (on_stop, lambda c: c.cancel(futures(), force=True)):
+            if stop is None:
+                continue
+            try:
+                stop(client)
+            except Exception:  # noqa: BLE001 - best effort
+                pass
+        close(client, cluster)
+        raise
+    close(client, cluster)
+
+
 def run_members(todo: Sequence[Member], total: int, done_before: int, *,
                 scheduler: str | None, workers: int, progress: bool,
                 echo: Callable[[str], None], desc: str = "sweep"
@@ -217,19 +245,17 @@ def run_members(todo: Sequence[Member], total: int, done_before: int, *,
 
     from tribodem.io import runs
 
-    client, cluster = open_client(scheduler, workers)
     results: dict[Hashable, dict[str, Any]] = {}
     failed: dict[Hashable, str] = {}
     tag = uuid.uuid4().hex[:8]
     stop_name = f"tribodem-sweep-{tag}-stop"
     futs: dict[Any, Member] = {}
-    pids: list[int] = []
-    try:
-        if cluster is not None:  # our own workers: killed at once on a stop
-            pids = list(client.run(os.getpid).values())
+    # on a stop the sweep's event is set: tasks on a remote cluster stop at their next look
+    with _session(scheduler, workers, lambda: list(futs),
+                  lambda c: Event(stop_name, client=c).set()) as (client, local):
         nthreads = client.nthreads()
         where = (f"local cluster of {len(nthreads)} worker process(es) x 1 thread"
-                 if cluster is not None else
+                 if local else
                  f"cluster at {client.scheduler.address} ({len(nthreads)} worker(s), "
                  f"{sum(nthreads.values())} thread(s) now)")
         for i, m in enumerate(todo):
@@ -265,19 +291,6 @@ def run_members(todo: Sequence[Member], total: int, done_before: int, *,
                     keys = {f.key for f in pending}
                     bar.set_postfix_str(f"done {len(results) + done_before}, running "
                                         f"{_running(client, keys)}, failed {len(failed)}")
-    except BaseException:  # Ctrl-C (or anything): stop the members now, then re-raise
-        _kill(pids)  # local workers: at once (every member file is written atomically)
-        try:
-            Event(stop_name, client=client).set()
-        except Exception:  # noqa: BLE001 - best effort
-            pass
-        try:
-            client.cancel(list(futs), force=True)
-        except Exception:  # noqa: BLE001 - best effort
-            pass
-        close(client, cluster)
-        raise
-    close(client, cluster)
     return results, failed, where
 
 
@@ -320,28 +333,17 @@ def task_map(scheduler: str | None, workers: int) -> Iterator[Mapper]:
     killed, the tasks cancelled and the client closed before the error goes on."""
     from distributed import as_completed
 
-    client, cluster = open_client(scheduler, workers)
-    pids = list(client.run(os.getpid).values()) if cluster is not None else []
     submitted: list[Any] = []
+    with _session(scheduler, workers, lambda: submitted) as (client, _):
 
-    def map_(fn: Callable[[Any], Any], items: Sequence[Any],
-             on_done: Callable[[], None] | None = None) -> list[Any]:
-        futs = [client.submit(fn, x, pure=False) for x in items]
-        submitted.extend(futs)
-        for f in as_completed(futs, loop=client.loop):
-            f.result()  # a failure raises here, at once
-            if on_done is not None:
-                on_done()
-        return [f.result() for f in futs]
+        def map_(fn: Callable[[Any], Any], items: Sequence[Any],
+                 on_done: Callable[[], None] | None = None) -> list[Any]:
+            futs = [client.submit(fn, x, pure=False) for x in items]
+            submitted.extend(futs)
+            for f in as_completed(futs, loop=client.loop):
+                f.result()  # a failure raises here, at once
+                if on_done is not None:
+                    on_done()
+            return [f.result() for f in futs]
 
-    try:
         yield map_
-    except BaseException:
-        _kill(pids)
-        try:
-            client.cancel(submitted, force=True)
-        except Exception:  # noqa: BLE001 - best effort
-            pass
-        close(client, cluster)
-        raise
-    close(client, cluster)
