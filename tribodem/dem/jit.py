@@ -3,10 +3,17 @@
 A threaded region costs tens of microseconds to launch, more than the whole work of a
 few hundred particles, so the engine picks the serial build below ``PARALLEL_MIN``
 items. Both builds come from the same plain function and are cached on disk.
+
+Threading layer: OpenMP first (``THREADING_LAYER_PRIORITY``), unless the user names one
+with ``NUMBA_THREADING_LAYER``. numba's own order puts TBB first, and with the TBB that
+Debian installs beside Yade a threaded region took ~100 us to launch against ~2 us for
+OpenMP (measured here, idle, 2 cores), which cost a 2-thread step of 20,000 spheres
+about 15 % (BENCHMARKS.md, session 15).
 """
 
 from __future__ import annotations
 
+import os
 import types
 from collections.abc import Callable
 from typing import Any
@@ -15,6 +22,9 @@ import numba
 from numba import njit
 
 PARALLEL_MIN = 4000
+
+if os.environ.get("NUMBA_THREADING_LAYER", "default") == "default":
+    numba.config.THREADING_LAYER_PRIORITY = ["omp", "tbb", "workqueue"]
 
 
 class Kernel:
