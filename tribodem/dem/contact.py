@@ -499,6 +499,191 @@ def pair_forces_sum(pos, vel, omega, radius, mass, inertia, mat, pair_i, pair_j,
         torque[j, 2] += b2
 
 
+#: particles per block of the threaded Newton pair pass (``pair_forces_blocked``): at
+#: least this many, and at least ``BLOCKS_PER_THREAD`` blocks per thread to balance them.
+#: The sums do not depend on the block size (see ``pair_forces_blocked``), so neither
+#: does any result.
+PAIR_BLOCK_MIN = 512
+BLOCKS_PER_THREAD = 8
+
+
+def pair_block_size(n: int, threads: int) -> int:
+    """Particles per block of ``pair_forces_cross`` / ``pair_forces_blocked`` for ``n``
+    particles on ``threads`` threads (any size gives the same bits)."""
+    return max(PAIR_BLOCK_MIN, -(-n // (BLOCKS_PER_THREAD * max(threads, 1))))
+
+
+@kernel(chunk=1)
+def pair_forces_cross(pos, vel, omega, radius, mass, inertia, mat, start, pair_j, hist,
+                      pairtab, elin, length, periodic, dim, thickness, dt, fpair, tpair_i,
+                      tpair_j, pinfo, bsize):
+    """First pass of the threaded Newton pairs: the pairs whose two particles lie in
+    different blocks of ``bsize`` particles (i's block ends before j; they close each
+    sorted row), stored as ``pair_forces`` stores them (``fpair``, ``tpair_i``,
+    ``tpair_j``, ``pinfo``, the history). Threads take blocks (prange over blocks); each
+    writes only its own pairs' rows."""
+    n = pos.shape[0]
+    nblk = (n + bsize - 1) // bsize
+    for blk in prange(nblk):
+        b1 = min(n, (blk + 1) * bsize)
+        for i in range(blk * bsize, b1):
+            p = start[i + 1] - 1
+            while p >= start[i] and pair_j[p] >= b1:
+                j = pair_j[p]
+                d0 = min_image(pos[j, 0] - pos[i, 0], length[0], periodic[0])
+                d1 = min_image(pos[j, 1] - pos[i, 1], length[1], periodic[1])
+                d2 = min_image(pos[j, 2] - pos[i, 2], length[2], periodic[2])
+                ri = radius[i]
+                rj = radius[j]
+                dist2 = d0 * d0 + d1 * d1 + d2 * d2
+                dist = np.sqrt(dist2)
+                delta = ri + rj - dist
+                if not (delta > 0.0 and dist2 > 0.0):  # apart: clear a contact just ended
+                    if pinfo[p, 0] > 0.0:
+                        for k in range(3):
+                            hist[p, k] = 0.0
+                            fpair[p, k] = 0.0
+                            tpair_i[p, k] = 0.0
+                            tpair_j[p, k] = 0.0
+                        pinfo[p, 1] = 0.0
+                        pinfo[p, 2] = 0.0
+                        pinfo[p, 3] = 0.0
+                    pinfo[p, 0] = delta
+                    p -= 1
+                    continue
+                prop = pairtab[mat[i], mat[j]]
+                lin_k, rstar, mstar, istar = _pair_consts(
+                    prop, ri, rj, mass[i], mass[j], inertia[i], inertia[j], elin[mat[i]],
+                    elin[mat[j]], dim, thickness)
+                (f0, f1, f2, a0, a1, a2, b0, b1_, b2, delta, fn, energy, kn, h0, h1,
+                 h2) = _pair(d0, d1, d2, dist, ri, rj, vel[i, 0], vel[i, 1], vel[i, 2],
+                             vel[j, 0], vel[j, 1], vel[j, 2], omega[i, 0], omega[i, 1],
+                             omega[i, 2], omega[j, 0], omega[j, 1], omega[j, 2], rstar, mstar,
+                             istar, prop, lin_k, hist[p, 0], hist[p, 1], hist[p, 2], dt)
+                hist[p, 0] = h0
+                hist[p, 1] = h1
+                hist[p, 2] = h2
+                fpair[p, 0] = f0
+                fpair[p, 1] = f1
+                fpair[p, 2] = f2
+                tpair_i[p, 0] = a0
+                tpair_i[p, 1] = a1
+                tpair_i[p, 2] = a2
+                tpair_j[p, 0] = b0
+                tpair_j[p, 1] = b1_
+                tpair_j[p, 2] = b2
+                pinfo[p, 0] = delta
+                pinfo[p, 1] = fn
+                pinfo[p, 2] = energy
+                pinfo[p, 3] = kn
+                p -= 1
+
+
+@kernel(chunk=1)
+def pair_forces_blocked(pos, vel, omega, radius, mass, inertia, mat, start, pair_i, pair_j,
+                        rev_start, rev_pair, hist, pairtab, elin, length, periodic, dim,
+                        thickness, dt, fpair, tpair_i, tpair_j, pinfo, force, torque, bsize):
+    """Second pass of the threaded Newton pairs (after ``pair_forces_cross``): the
+    particle sums ``force``/``torque`` (N, N m) of every pair, bitwise those of the serial
+    ``pair_forces_sum``, with no pass over all pairs' stored forces.
+
+    Threads take blocks of ``bsize`` particles (prange over blocks). A block first
+    zeroes its particles and adds the stored cross pairs of the earlier blocks where they
+    are j (the head of each reverse-index row: pairs of lower i come first); then it
+    walks its own rows in increasing pair index: a pair inside the block is evaluated
+    and summed into both particles (Newton), a cross pair adds its stored force and
+    torque to i. Every particle thus receives its pairs in increasing pair index, the
+    serial kernel's order: the same bits on any number of threads and for any block
+    size. Pairs inside a block store ``fpair`` and ``pinfo`` (not ``tpair_*``), as
+    ``pair_forces_sum`` does. A cross pair apart holds zeros, and adding a zero leaves
+    a sum's bits as they are (a running sum from +0 is never -0)."""
+    n = pos.shape[0]
+    nblk = (n + bsize - 1) // bsize
+    for blk in prange(nblk):
+        b0_ = blk * bsize
+        b1 = min(n, b0_ + bsize)
+        for k in range(b0_, b1):
+            s0 = s1 = s2 = u0 = u1 = u2 = 0.0
+            for q in range(rev_start[k], rev_start[k + 1]):
+                p = rev_pair[q]
+                if pair_i[p] >= b0_:
+                    break
+                s0 += fpair[p, 0]
+                s1 += fpair[p, 1]
+                s2 += fpair[p, 2]
+                u0 += tpair_j[p, 0]
+                u1 += tpair_j[p, 1]
+                u2 += tpair_j[p, 2]
+            force[k, 0] = s0
+            force[k, 1] = s1
+            force[k, 2] = s2
+            torque[k, 0] = u0
+            torque[k, 1] = u1
+            torque[k, 2] = u2
+        for i in range(b0_, b1):
+            for p in range(start[i], start[i + 1]):
+                j = pair_j[p]
+                if j >= b1:  # cross pair: evaluated by pair_forces_cross
+                    force[i, 0] -= fpair[p, 0]
+                    force[i, 1] -= fpair[p, 1]
+                    force[i, 2] -= fpair[p, 2]
+                    torque[i, 0] += tpair_i[p, 0]
+                    torque[i, 1] += tpair_i[p, 1]
+                    torque[i, 2] += tpair_i[p, 2]
+                    continue
+                d0 = min_image(pos[j, 0] - pos[i, 0], length[0], periodic[0])
+                d1 = min_image(pos[j, 1] - pos[i, 1], length[1], periodic[1])
+                d2 = min_image(pos[j, 2] - pos[i, 2], length[2], periodic[2])
+                ri = radius[i]
+                rj = radius[j]
+                dist2 = d0 * d0 + d1 * d1 + d2 * d2
+                dist = np.sqrt(dist2)
+                delta = ri + rj - dist
+                if not (delta > 0.0 and dist2 > 0.0):  # apart: clear a contact just ended
+                    if pinfo[p, 0] > 0.0:
+                        for k in range(3):
+                            hist[p, k] = 0.0
+                            fpair[p, k] = 0.0
+                            tpair_i[p, k] = 0.0
+                            tpair_j[p, k] = 0.0
+                        pinfo[p, 1] = 0.0
+                        pinfo[p, 2] = 0.0
+                        pinfo[p, 3] = 0.0
+                    pinfo[p, 0] = delta
+                    continue
+                prop = pairtab[mat[i], mat[j]]
+                lin_k, rstar, mstar, istar = _pair_consts(
+                    prop, ri, rj, mass[i], mass[j], inertia[i], inertia[j], elin[mat[i]],
+                    elin[mat[j]], dim, thickness)
+                (f0, f1, f2, a0, a1, a2, c0, c1, c2, delta, fn, energy, kn, h0, h1,
+                 h2) = _pair(d0, d1, d2, dist, ri, rj, vel[i, 0], vel[i, 1], vel[i, 2],
+                             vel[j, 0], vel[j, 1], vel[j, 2], omega[i, 0], omega[i, 1],
+                             omega[i, 2], omega[j, 0], omega[j, 1], omega[j, 2], rstar, mstar,
+                             istar, prop, lin_k, hist[p, 0], hist[p, 1], hist[p, 2], dt)
+                hist[p, 0] = h0
+                hist[p, 1] = h1
+                hist[p, 2] = h2
+                fpair[p, 0] = f0
+                fpair[p, 1] = f1
+                fpair[p, 2] = f2
+                pinfo[p, 0] = delta
+                pinfo[p, 1] = fn
+                pinfo[p, 2] = energy
+                pinfo[p, 3] = kn
+                force[i, 0] -= f0
+                force[i, 1] -= f1
+                force[i, 2] -= f2
+                torque[i, 0] += a0
+                torque[i, 1] += a1
+                torque[i, 2] += a2
+                force[j, 0] += f0
+                force[j, 1] += f1
+                force[j, 2] += f2
+                torque[j, 0] += c0
+                torque[j, 1] += c1
+                torque[j, 2] += c2
+
+
 @njit(cache=True, inline="always")
 def response_2d(law, prop, n0, n1, delta, v0, v1, w2, rstar, mstar, istar, lin_k, h0, h1,
                 dt):

@@ -35,8 +35,10 @@ from tribodem.dem.contact import (
     HIST,
     N_PCONST,
     Material,
+    pair_block_size,
     pair_constants,
-    pair_forces,
+    pair_forces_blocked,
+    pair_forces_cross,
     pair_forces_sum,
     pair_forces_sum_2d,
     pair_table,
@@ -484,21 +486,34 @@ class Simulation:
         self._build_wall_list()
 
     def _pair_forces(self) -> None:
-        """Contacts of the listed pairs. On one thread (or a short list) the serial kernel
-        also sums them into ``force``/``torque`` (Newton pairs, no gather pass; disks: its
-        planar build ``pair_forces_sum_2d``); threaded, each pair is stored and ``advance``
-        gathers them in the same order."""
+        """Contacts of the listed pairs, summed into ``force``/``torque`` (Newton pairs, no
+        gather pass). On one thread (or a short list) the serial kernel (disks: its planar
+        build ``pair_forces_sum_2d``); threaded, blocks of particles in two passes
+        (``pair_forces_cross``, then ``pair_forces_blocked``), which sum every particle's
+        pairs in the serial kernel's order: the same bits on any number of threads."""
         p = self.p
         args = (p.pos, p.vel, p.omega, p.radius, p.mass, p.inertia, p.mat, self.nl.pair_i,
                 self.nl.pair_j, self.hist, self.pairtab, self.elin, self.box_length,
                 self.box.periodic, p.dim, p.thickness, self.dt, self.fpair, self.tpair_i,
                 self.tpair_j, self.pinfo)
-        self._summed = serial_run(self.nl.n_pairs, self._threads)
-        if self._summed:
+        self._summed = True
+        if serial_run(self.nl.n_pairs, self._threads):
             fn = pair_forces_sum_2d if p.dim == 2 else pair_forces_sum
             laws.active(fn).serial(*args, self.force, self.torque, None)
         else:
-            laws.active(pair_forces).pick(self.nl.n_pairs, self._threads)(*args)
+            nl = self.nl
+            bsize = pair_block_size(p.n, self._threads or numba.get_num_threads())
+            laws.active(pair_forces_cross).pick(nl.n_pairs, self._threads)(
+                p.pos, p.vel, p.omega, p.radius, p.mass, p.inertia, p.mat, nl.start,
+                nl.pair_j, self.hist, self.pairtab, self.elin, self.box_length,
+                self.box.periodic, p.dim, p.thickness, self.dt, self.fpair, self.tpair_i,
+                self.tpair_j, self.pinfo, bsize)
+            laws.active(pair_forces_blocked).pick(nl.n_pairs, self._threads)(
+                p.pos, p.vel, p.omega, p.radius, p.mass, p.inertia, p.mat, nl.start,
+                nl.pair_i, nl.pair_j, nl.rev_start, nl.rev_pair, self.hist, self.pairtab,
+                self.elin, self.box_length, self.box.periodic, p.dim, p.thickness, self.dt,
+                self.fpair, self.tpair_i, self.tpair_j, self.pinfo, self.force, self.torque,
+                bsize)
         self._evaluated = True
 
     def _wall_pass(self) -> None:
