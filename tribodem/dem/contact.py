@@ -4,7 +4,8 @@ The normal laws are styles in :mod:`tribodem.dem.laws` (``linear``: PFC deformab
 ``hertz``: Hertz-Mindlin no-slip, as EDEM/LIGGGHTS; more by ``laws.register``). Common to
 all: Coulomb friction on a shear spring carried in the contact history, constant
 directional torque (CDT) rolling friction ``mu_r Fn R*`` opposing relative rolling
-(``contact_response``), and the pair kernel ``pair_forces``.
+(``contact_response``), and the pair kernels: ``pair_forces_sum`` (serial) and
+``pair_forces_cross`` + ``pair_forces_blocked`` (threaded), the same sums.
 """
 
 from __future__ import annotations
@@ -345,84 +346,19 @@ def _pair(d0, d1, d2, dist, ri, rj, vi0, vi1, vi2, vj0, vj1, vj2, wi0, wi1, wi2,
             -aj * ty - r1, -aj * tz - r2, delta, fn, energy, kn, h0, h1, h2)
 
 
-@kernel(chunk=512)
-def pair_forces(pos, vel, omega, radius, mass, inertia, mat, pair_i, pair_j, hist, pairtab,
-                elin, length, periodic, dim, thickness, dt, fpair, tpair_i, tpair_j, pinfo):
-    """Forces of all listed pairs (prange over pairs; no shared writes).
-
-    fpair[p]: force on j (i gets minus it); tpair_i/tpair_j: torques (N m);
-    pinfo[p] = (overlap m, normal force N, energy J, kn N/m). A pair found apart is
-    cleared only if it was in contact (pinfo[p, 0] > 0) at the previous evaluation.
-    Particles gather these in ``integrate.advance`` (threaded runs).
-    """
-    m = pair_i.shape[0]
-    for p in prange(m):
-        i = pair_i[p]
-        j = pair_j[p]
-        d0 = min_image(pos[j, 0] - pos[i, 0], length[0], periodic[0])
-        d1 = min_image(pos[j, 1] - pos[i, 1], length[1], periodic[1])
-        d2 = min_image(pos[j, 2] - pos[i, 2], length[2], periodic[2])
-        ri = radius[i]
-        rj = radius[j]
-        dist2 = d0 * d0 + d1 * d1 + d2 * d2
-        rs = ri + rj
-        f0 = f1 = f2 = a0 = a1 = a2 = b0 = b1 = b2 = fn = energy = kn = 0.0
-        dist = np.sqrt(dist2)
-        delta = rs - dist
-        if delta > 0.0 and dist2 > 0.0:
-            prop = pairtab[mat[i], mat[j]]
-            lin_k, rstar, mstar, istar = _pair_consts(
-                prop, ri, rj, mass[i], mass[j], inertia[i], inertia[j], elin[mat[i]],
-                elin[mat[j]], dim, thickness)
-            (f0, f1, f2, a0, a1, a2, b0, b1, b2, delta, fn, energy, kn, h0, h1, h2) = _pair(
-                d0, d1, d2, dist, ri, rj, vel[i, 0], vel[i, 1], vel[i, 2], vel[j, 0], vel[j, 1],
-                vel[j, 2], omega[i, 0], omega[i, 1], omega[i, 2], omega[j, 0], omega[j, 1],
-                omega[j, 2], rstar, mstar, istar, prop, lin_k, hist[p, 0], hist[p, 1],
-                hist[p, 2], dt)
-            hist[p, 0] = h0
-            hist[p, 1] = h1
-            hist[p, 2] = h2
-        if not (delta > 0.0 and dist2 > 0.0):  # apart: clear a contact that just ended
-            if pinfo[p, 0] > 0.0:
-                for k in range(3):
-                    hist[p, k] = 0.0
-                    fpair[p, k] = 0.0
-                    tpair_i[p, k] = 0.0
-                    tpair_j[p, k] = 0.0
-                pinfo[p, 1] = 0.0
-                pinfo[p, 2] = 0.0
-                pinfo[p, 3] = 0.0
-            pinfo[p, 0] = delta
-            continue
-        fpair[p, 0] = f0
-        fpair[p, 1] = f1
-        fpair[p, 2] = f2
-        tpair_i[p, 0] = a0
-        tpair_i[p, 1] = a1
-        tpair_i[p, 2] = a2
-        tpair_j[p, 0] = b0
-        tpair_j[p, 1] = b1
-        tpair_j[p, 2] = b2
-        pinfo[p, 0] = delta
-        pinfo[p, 1] = fn
-        pinfo[p, 2] = energy
-        pinfo[p, 3] = kn
-
-
 @kernel
 def pair_forces_sum(pos, vel, omega, radius, mass, inertia, mat, pair_i, pair_j, hist, pairtab,
                     elin, length, periodic, dim, thickness, dt, fpair, tpair_i, tpair_j, pinfo,
                     force, torque, pconst):
-    """Serial pass of ``pair_forces`` that also sums every pair straight into the particles
-    (Newton pairs, as LIGGGHTS): ``force``/``torque`` (N, N m) are zeroed, then each
-    touching pair p adds ``-fpair[p]`` / its torque on i to i and ``+fpair[p]`` / its
-    torque on j to j in increasing p. ``tpair_*`` are not stored (only cleared when a
-    contact ends).
-
-    Particle k thus receives its pairs in increasing p: first those where it is j (owned
-    by lower particles), then its own -- the order in which ``integrate.advance`` gathers
-    them after the threaded ``pair_forces``, so both give bitwise the same sums. Run it
-    through its serial build only (the loop writes shared rows).
+    """Forces of all listed pairs, summed straight into the particles (Newton pairs, as
+    LIGGGHTS): ``force``/``torque`` (N, N m) are zeroed, then each touching pair p adds
+    ``-fpair[p]`` / its torque on i to i and ``+fpair[p]`` / its torque on j to j in
+    increasing p. ``fpair[p]``: force on j (N); ``pinfo[p]`` = (overlap m, normal force N,
+    energy J, kn N/m). A pair found apart is cleared only if it was in contact
+    (``pinfo[p, 0] > 0``) at the previous evaluation; ``tpair_*`` are not stored (only
+    cleared when a contact ends). Run it through its serial build only (the loop writes
+    shared rows); threaded runs use ``pair_forces_cross`` + ``pair_forces_blocked``,
+    which give each particle its pairs in the same increasing p: the same bits.
 
     ``pconst``: the pairs' constants (``pair_constants``, valid while radii, masses and
     materials are unchanged) or ``None`` (computed per contact): the same values either
@@ -519,8 +455,8 @@ def pair_forces_cross(pos, vel, omega, radius, mass, inertia, mat, start, pair_j
                       tpair_j, pinfo, bsize):
     """First pass of the threaded Newton pairs: the pairs whose two particles lie in
     different blocks of ``bsize`` particles (i's block ends before j; they close each
-    sorted row), stored as ``pair_forces`` stores them (``fpair``, ``tpair_i``,
-    ``tpair_j``, ``pinfo``, the history). Threads take blocks (prange over blocks); each
+    sorted row), stored with both torques (``fpair``, ``tpair_i``, ``tpair_j``,
+    ``pinfo``, the history). Threads take blocks (prange over blocks); each
     writes only its own pairs' rows."""
     n = pos.shape[0]
     nblk = (n + bsize - 1) // bsize

@@ -1,8 +1,9 @@
 """``Simulation``: the step loop that wires the kernels, plus checkpoints and stability checks.
 
-One step: (re)build the neighbour list if needed -> pair contact forces -> extra
-interactions (bonds, thermal, ... added as ``Interaction`` objects) -> per particle:
-gather, wall contacts, central-difference update, periodic wrap -> walls move (servo).
+One step: (re)build the neighbour list if needed -> pair contact forces, summed into the
+particles -> extra interactions (bonds, thermal, ... added as ``Interaction`` objects) ->
+wall contacts -> per particle: the sum of its forces, central-difference update, periodic
+wrap -> walls move (servo).
 The engine knows nothing about brakes or fretting; applications compose it.
 """
 
@@ -232,8 +233,7 @@ def _run_steps(c, states, nmax, step0, check_every, max_ratio):  # pragma: no co
                                  + c.wall_tot[w, 1] * c.wall_normal[w, 1]
                                  + c.wall_tot[w, 2] * c.wall_normal[w, 2])
         _advance_serial(c.pos, c.vel, c.omega, c.radius, c.mass, c.inertia, c.fixed,
-                        c.start, c.rev_start, c.rev_pair, c.fpair, c.tpair_i, c.tpair_j,
-                        True, c.wstart, c.wforce, c.wtorque, c.dt, c.gravity, c.viscous,
+                        c.wstart, c.wforce, c.wtorque, c.dt, c.gravity, c.viscous,
                         c.local, c.has_ext, c.ext_force, c.ext_torque, c.force, c.torque,
                         c.ref_pos, c.ref_radius, c.lo, c.length, c.periodic, c.drift)
         _move_walls(c)
@@ -397,7 +397,6 @@ class Simulation:
         self.pinfo = np.zeros((m, 4))
         self.pinfo[:, 0] = 1.0  # unknown yet: the first evaluation clears what is apart
         self._evaluated = False  # pinfo holds no evaluation yet (see _active)
-        self._summed = False  # force/torque hold this step's pair sums (serial kernel)
 
     def add_interaction(self, inter: Interaction) -> None:
         """Add an extra force contribution, evaluated every step after contacts.
@@ -496,7 +495,6 @@ class Simulation:
                 self.nl.pair_j, self.hist, self.pairtab, self.elin, self.box_length,
                 self.box.periodic, p.dim, p.thickness, self.dt, self.fpair, self.tpair_i,
                 self.tpair_j, self.pinfo)
-        self._summed = True
         if serial_run(self.nl.n_pairs, self._threads):
             fn = pair_forces_sum_2d if p.dim == 2 else pair_forces_sum
             laws.active(fn).serial(*args, self.force, self.torque, None)
@@ -540,9 +538,8 @@ class Simulation:
     def _advance(self) -> None:
         p = self.p
         advance.pick(p.n, self._threads)(
-            p.pos, p.vel, p.omega, p.radius, p.mass, p.inertia, p.fixed, self.nl.start,
-            self.nl.rev_start, self.nl.rev_pair, self.fpair, self.tpair_i, self.tpair_j,
-            self._summed, self._wstart, self._wforce, self._wtorque, self.dt, self.gravity,
+            p.pos, p.vel, p.omega, p.radius, p.mass, p.inertia, p.fixed, self._wstart,
+            self._wforce, self._wtorque, self.dt, self.gravity,
             self.viscous_damping, self.local_damping, bool(self.interactions), self.ext_force,
             self.ext_torque, self.force, self.torque, self.nl.ref_pos, self.nl.ref_radius,
             self.box.lo, self.box_length, self.box.periodic, self.drift)
@@ -551,7 +548,7 @@ class Simulation:
         """Advance ``n`` steps. Raises ``SimulationUnstable`` (recorders flushed) on blow-up.
 
         A step: neighbour list if needed -> pair contacts -> extra interactions (into
-        ``ext_force``/``ext_torque``) -> per particle: gather, walls, update, wrap ->
+        ``ext_force``/``ext_torque``) -> walls -> per particle: sum, update, wrap ->
         ``after_advance`` hooks (clump bodies) -> walls move (servo uses the wall force
         just measured). Runs of steps go through one compiled loop when every piece has a
         compiled form (``_compiled_states``), else step by step in Python.
@@ -655,7 +652,6 @@ class Simulation:
         c = self._context()
         k, _why, _events = _run_steps(c, states, limit, self.step_count, self.check_every,
                                       self.max_overlap_ratio)
-        self._summed = True
         self._evaluated = True
         rows = c.wall_tot.tolist()
         for w_id, w in enumerate(self.walls):

@@ -81,22 +81,16 @@ def _update(pos, vel, omega, i, f0, f1, f2, t0, t1, t2, m, inertia, fixed, a, b,
 
 
 @kernel(chunk=2)
-def advance(pos, vel, omega, radius, mass, inertia, fixed, start, rev_start, rev_pair,
-            fpair, tpair_i, tpair_j, summed, wstart, wforce, wtorque, dt, gravity, viscous,
-            local, has_ext, ext_force, ext_torque, force, torque, ref_pos, ref_radius, lo,
-            length, periodic, drift):
-    """One step for every particle: its pair forces, the wall pass's force and torque
-    (``walls.wall_forces``, particles with near-wall candidates ``wstart``), external
-    forces (``has_ext``), gravity, then the central-difference update with damping and the
-    periodic wrap.
-
-    Pair sums: with ``summed`` they are already in ``force``/``torque`` (the serial
-    ``contact.pair_forces_sum``); otherwise they are gathered from ``fpair``/``tpair_*``
-    in increasing pair index (first the pairs where the particle is j, through the
-    reverse index, then its own), the order of ``pair_forces_sum``: the same bits on any
-    number of threads. Writes the total force/torque without gravity (``force``,
-    ``torque``, N and N m) and per-block ``drift`` (largest move plus growth since the
-    last neighbour build, m).
+def advance(pos, vel, omega, radius, mass, inertia, fixed, wstart, wforce, wtorque, dt,
+            gravity, viscous, local, has_ext, ext_force, ext_torque, force, torque, ref_pos,
+            ref_radius, lo, length, periodic, drift):
+    """One step for every particle: its pair forces (already summed into ``force`` /
+    ``torque`` by the pair kernels, ``contact.pair_forces_sum`` or the blocked pair), the
+    wall pass's force and torque (``walls.wall_forces``, particles with near-wall
+    candidates ``wstart``), external forces (``has_ext``), gravity, then the
+    central-difference update with damping and the periodic wrap. Writes the total
+    force/torque without gravity (``force``, ``torque``, N and N m) and per-block
+    ``drift`` (largest move plus growth since the last neighbour build, m).
     """
     n = pos.shape[0]
     nblocks = (n + BLOCK - 1) // BLOCK
@@ -111,30 +105,12 @@ def advance(pos, vel, omega, radius, mass, inertia, fixed, start, rev_start, rev
         dmax = 0.0
         dmax2 = 0.0
         for i in range(blk * BLOCK, min(n, (blk + 1) * BLOCK)):
-            if summed:
-                f0 = force[i, 0]
-                f1 = force[i, 1]
-                f2 = force[i, 2]
-                t0 = torque[i, 0]
-                t1 = torque[i, 1]
-                t2 = torque[i, 2]
-            else:
-                f0 = f1 = f2 = t0 = t1 = t2 = 0.0
-                for q in range(rev_start[i], rev_start[i + 1]):
-                    p = rev_pair[q]
-                    f0 += fpair[p, 0]
-                    f1 += fpair[p, 1]
-                    f2 += fpair[p, 2]
-                    t0 += tpair_j[p, 0]
-                    t1 += tpair_j[p, 1]
-                    t2 += tpair_j[p, 2]
-                for p in range(start[i], start[i + 1]):
-                    f0 -= fpair[p, 0]
-                    f1 -= fpair[p, 1]
-                    f2 -= fpair[p, 2]
-                    t0 += tpair_i[p, 0]
-                    t1 += tpair_i[p, 1]
-                    t2 += tpair_i[p, 2]
+            f0 = force[i, 0]
+            f1 = force[i, 1]
+            f2 = force[i, 2]
+            t0 = torque[i, 0]
+            t1 = torque[i, 1]
+            t2 = torque[i, 2]
             if wstart[i + 1] > wstart[i]:
                 f0 += wforce[i, 0]
                 f1 += wforce[i, 1]
