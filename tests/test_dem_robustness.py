@@ -105,3 +105,54 @@ def test_same_result_on_one_and_two_threads() -> None:
     assert np.array_equal(finals[0][0], finals[1][0])
     assert np.array_equal(finals[0][1], finals[1][1])
     assert finals[0][2] == finals[1][2] and finals[0][2] > 0
+
+
+def test_blocked_pair_sums_do_not_depend_on_the_cut() -> None:
+    """The threaded pair pass (cross pairs, then blocks) gives the serial Newton kernel's
+    sums bitwise for any cut into blocks: equal pair work, one block, empty blocks, random
+    cuts (each particle adds its pairs in increasing pair index)."""
+    from tribodem.dem.bench import simulation_from_case
+    from tribodem.dem.bench_cases import settle3d_case
+    from tribodem.dem.contact import (
+        pair_block_bounds,
+        pair_forces_blocked,
+        pair_forces_cross,
+        pair_forces_sum,
+    )
+
+    sim = simulation_from_case(settle3d_case(n=3000, steps=400))
+    sim.step(400)  # a bed with contacts, some of them just ended
+    p, nl = sim.p, sim.nl
+    state = (sim.hist, sim.pinfo, sim.fpair, sim.tpair_i, sim.tpair_j)
+
+    def common():
+        hist, pinfo, fpair, ti, tj = (a.copy() for a in state)
+        return hist, pinfo, fpair, ti, tj, np.zeros_like(p.pos), np.zeros_like(p.pos)
+
+    hist, pinfo, fpair, ti, tj, force, torque = common()
+    pair_forces_sum.serial(p.pos, p.vel, p.omega, p.radius, p.mass, p.inertia, p.mat,
+                           nl.pair_i, nl.pair_j, hist, sim.pairtab, sim.elin, sim.box_length,
+                           sim.box.periodic, p.dim, p.thickness, sim.dt, fpair, ti, tj, pinfo,
+                           force, torque, None)
+    assert np.count_nonzero(pinfo[:, 0] > 0) > 200
+    balanced = np.zeros(5, dtype=np.int64)
+    pair_block_bounds(nl.start, sim.pinfo, 4, balanced)
+    rng = np.random.default_rng(3)
+    cuts = [balanced, np.array([0, p.n]), np.array([0, 0, 1000, 1000, p.n, p.n]),
+            np.concatenate([[0], np.sort(rng.integers(0, p.n, 9)), [p.n]])]
+    for bounds in cuts:
+        h2, pi2, f2, ti2, tj2, force2, torque2 = common()
+        pair_forces_cross.parallel(p.pos, p.vel, p.omega, p.radius, p.mass, p.inertia, p.mat,
+                                   nl.start, nl.pair_j, h2, sim.pairtab, sim.elin,
+                                   sim.box_length, sim.box.periodic, p.dim, p.thickness,
+                                   sim.dt, f2, ti2, tj2, pi2, bounds)
+        pair_forces_blocked.parallel(p.pos, p.vel, p.omega, p.radius, p.mass, p.inertia,
+                                     p.mat, nl.start, nl.pair_i, nl.pair_j, nl.rev_start,
+                                     nl.rev_pair, h2, sim.pairtab, sim.elin, sim.box_length,
+                                     sim.box.periodic, p.dim, p.thickness, sim.dt, f2, ti2,
+                                     tj2, pi2, force2, torque2, bounds)
+        assert np.array_equal(force2, force), bounds
+        assert np.array_equal(torque2, torque), bounds
+        assert np.array_equal(h2, hist) and np.array_equal(pi2, pinfo)
+        assert np.array_equal(f2, fpair)
+    assert 0 < balanced[1] < balanced[2] < balanced[3] < p.n

@@ -435,36 +435,58 @@ def pair_forces_sum(pos, vel, omega, radius, mass, inertia, mat, pair_i, pair_j,
         torque[j, 2] += b2
 
 
-#: particles per block of the threaded Newton pair pass (``pair_forces_blocked``): at
-#: least this many, and ``BLOCKS_PER_THREAD`` blocks per thread (fewer, larger blocks
-#: leave fewer pairs across blocks to store; two per thread let a thread that finishes
-#: first take another: settle3d 20k on 2 threads, interleaved, 1,172-1,218 us per step
-#: at 2 blocks per thread against 1,286-1,314 at 8). The sums do not depend on the block
-#: size (see ``pair_forces_blocked``), so neither does any result.
-PAIR_BLOCK_MIN = 512
+#: blocks per thread of the threaded Newton pair pass (``pair_forces_blocked``): fewer,
+#: larger blocks leave fewer pairs across blocks to store; two per thread let a thread
+#: that finishes first take another (settle3d 20k on 2 threads, interleaved: 1,172-1,218
+#: us per step at 2 blocks per thread against 1,286-1,314 at 8, equal-count blocks).
 BLOCKS_PER_THREAD = 2
+#: the work of a touching pair against a listed pair found apart, for the block cuts
+CONTACT_WORK = 3.0
 
 
-def pair_block_size(n: int, threads: int) -> int:
-    """Particles per block of ``pair_forces_cross`` / ``pair_forces_blocked`` for ``n``
-    particles on ``threads`` threads (any size gives the same bits)."""
-    return max(PAIR_BLOCK_MIN, -(-n // (BLOCKS_PER_THREAD * max(threads, 1))))
+@njit(cache=True)
+def pair_block_bounds(start, pinfo, nblk, bounds):  # pragma: no cover - numba
+    """Cut the particles into ``nblk`` contiguous blocks of about equal pair work:
+    ``bounds[b]:bounds[b + 1]`` is block b (``bounds`` has ``nblk + 1`` entries). A
+    particle's work is its own row of the list, a listed pair counting 1 and a pair
+    touching at the last evaluation (``pinfo[p, 0] > 0``) ``1 + CONTACT_WORK`` (in a
+    settling bed the bottom blocks hold most contacts: equal particle counts left one
+    thread idle). Any cut gives the same sums (``pair_forces_blocked``), so the cuts may
+    change at any step without changing a bit."""
+    n = start.shape[0] - 1
+    total = 0.0
+    for p in range(start[n]):
+        total += 1.0 + (CONTACT_WORK if pinfo[p, 0] > 0.0 else 0.0)
+    bounds[0] = 0
+    b = 1
+    acc = 0.0
+    for i in range(n):
+        if b >= nblk:
+            break
+        for p in range(start[i], start[i + 1]):
+            acc += 1.0 + (CONTACT_WORK if pinfo[p, 0] > 0.0 else 0.0)
+        while b < nblk and acc >= total * b / nblk:
+            bounds[b] = i + 1
+            b += 1
+    while b < nblk:
+        bounds[b] = n
+        b += 1
+    bounds[nblk] = n
 
 
 @kernel(chunk=1)
 def pair_forces_cross(pos, vel, omega, radius, mass, inertia, mat, start, pair_j, hist,
                       pairtab, elin, length, periodic, dim, thickness, dt, fpair, tpair_i,
-                      tpair_j, pinfo, bsize):
+                      tpair_j, pinfo, bounds):
     """First pass of the threaded Newton pairs: the pairs whose two particles lie in
-    different blocks of ``bsize`` particles (i's block ends before j; they close each
-    sorted row), stored with both torques (``fpair``, ``tpair_i``, ``tpair_j``,
+    different blocks (``bounds``, ``pair_block_bounds``; i's block ends before j: they
+    close each sorted row), stored with both torques (``fpair``, ``tpair_i``, ``tpair_j``,
     ``pinfo``, the history). Threads take blocks (prange over blocks); each
     writes only its own pairs' rows."""
-    n = pos.shape[0]
-    nblk = (n + bsize - 1) // bsize
+    nblk = bounds.shape[0] - 1
     for blk in prange(nblk):
-        b1 = min(n, (blk + 1) * bsize)
-        for i in range(blk * bsize, b1):
+        b1 = bounds[blk + 1]
+        for i in range(bounds[blk], b1):
             p = start[i + 1] - 1
             while p >= start[i] and pair_j[p] >= b1:
                 j = pair_j[p]
@@ -520,26 +542,26 @@ def pair_forces_cross(pos, vel, omega, radius, mass, inertia, mat, start, pair_j
 @kernel(chunk=1)
 def pair_forces_blocked(pos, vel, omega, radius, mass, inertia, mat, start, pair_i, pair_j,
                         rev_start, rev_pair, hist, pairtab, elin, length, periodic, dim,
-                        thickness, dt, fpair, tpair_i, tpair_j, pinfo, force, torque, bsize):
+                        thickness, dt, fpair, tpair_i, tpair_j, pinfo, force, torque, bounds):
     """Second pass of the threaded Newton pairs (after ``pair_forces_cross``): the
     particle sums ``force``/``torque`` (N, N m) of every pair, bitwise those of the serial
     ``pair_forces_sum``, with no pass over all pairs' stored forces.
 
-    Threads take blocks of ``bsize`` particles (prange over blocks). A block first
+    Threads take the blocks of ``bounds`` (``pair_block_bounds``; prange over blocks),
+    contiguous ranges of particles. A block first
     zeroes its particles and adds the stored cross pairs of the earlier blocks where they
     are j (the head of each reverse-index row: pairs of lower i come first); then it
     walks its own rows in increasing pair index: a pair inside the block is evaluated
     and summed into both particles (Newton), a cross pair adds its stored force and
     torque to i. Every particle thus receives its pairs in increasing pair index, the
-    serial kernel's order: the same bits on any number of threads and for any block
-    size. Pairs inside a block store ``fpair`` and ``pinfo`` (not ``tpair_*``), as
+    serial kernel's order: the same bits on any number of threads and for any cut
+    into blocks. Pairs inside a block store ``fpair`` and ``pinfo`` (not ``tpair_*``), as
     ``pair_forces_sum`` does. A cross pair apart holds zeros, and adding a zero leaves
     a sum's bits as they are (a running sum from +0 is never -0)."""
-    n = pos.shape[0]
-    nblk = (n + bsize - 1) // bsize
+    nblk = bounds.shape[0] - 1
     for blk in prange(nblk):
-        b0_ = blk * bsize
-        b1 = min(n, b0_ + bsize)
+        b0_ = bounds[blk]
+        b1 = bounds[blk + 1]
         for k in range(b0_, b1):
             s0 = s1 = s2 = u0 = u1 = u2 = 0.0
             for q in range(rev_start[k], rev_start[k + 1]):

@@ -33,10 +33,11 @@ from tribodem.dem.compiled import (
     registered,
 )
 from tribodem.dem.contact import (
+    BLOCKS_PER_THREAD,
     HIST,
     N_PCONST,
     Material,
-    pair_block_size,
+    pair_block_bounds,
     pair_constants,
     pair_forces_blocked,
     pair_forces_cross,
@@ -60,6 +61,8 @@ from tribodem.dem.walls import (
 from tribodem.io.results import write_npz
 
 CHECKPOINT_VERSION = 1
+#: steps between two cuts of the threaded pair pass's blocks (``Simulation._block_bounds``)
+REBALANCE_EVERY = 100
 
 
 @numba.njit(cache=True)
@@ -328,6 +331,8 @@ class Simulation:
         self.hist = np.zeros((self.nl.n_pairs, HIST))
         self._threads: int | None = None  # numba threads, read once per step() call
         self._cross = np.zeros(0)  # cross_group_force's buffer
+        self._bounds = np.zeros(0, dtype=np.int64)  # the threaded pair pass's blocks
+        self._bounds_key: tuple = ()
         #: ``box.length`` as of the current ``step()`` call (read once per call by the
         #: kernels and interactions; a box changed between calls is seen at the next)
         self.box_length = self.box.length
@@ -500,19 +505,34 @@ class Simulation:
             laws.active(fn).serial(*args, self.force, self.torque, None)
         else:
             nl = self.nl
-            bsize = pair_block_size(p.n, self._threads or numba.get_num_threads())
+            bounds = self._block_bounds()
             laws.active(pair_forces_cross).pick(nl.n_pairs, self._threads)(
                 p.pos, p.vel, p.omega, p.radius, p.mass, p.inertia, p.mat, nl.start,
                 nl.pair_j, self.hist, self.pairtab, self.elin, self.box_length,
                 self.box.periodic, p.dim, p.thickness, self.dt, self.fpair, self.tpair_i,
-                self.tpair_j, self.pinfo, bsize)
+                self.tpair_j, self.pinfo, bounds)
             laws.active(pair_forces_blocked).pick(nl.n_pairs, self._threads)(
                 p.pos, p.vel, p.omega, p.radius, p.mass, p.inertia, p.mat, nl.start,
                 nl.pair_i, nl.pair_j, nl.rev_start, nl.rev_pair, self.hist, self.pairtab,
                 self.elin, self.box_length, self.box.periodic, p.dim, p.thickness, self.dt,
                 self.fpair, self.tpair_i, self.tpair_j, self.pinfo, self.force, self.torque,
-                bsize)
+                bounds)
         self._evaluated = True
+
+    def _block_bounds(self) -> np.ndarray:
+        """The blocks of the threaded pair pass (``contact.pair_block_bounds``: equal pair
+        work, ``BLOCKS_PER_THREAD`` per thread), cut again after a neighbour rebuild and
+        every ``REBALANCE_EVERY`` steps as contacts move (no result depends on them). A
+        cut made on a new list (whose ``pinfo`` holds placeholders) is made again once
+        the list has been evaluated."""
+        nblk = BLOCKS_PER_THREAD * max(self._threads or numba.get_num_threads(), 1)
+        key = (id(self.nl), nblk, self._evaluated)
+        if key != self._bounds_key or self.step_count % REBALANCE_EVERY == 0:
+            if self._bounds.shape[0] != nblk + 1:
+                self._bounds = np.zeros(nblk + 1, dtype=np.int64)
+            pair_block_bounds(self.nl.start, self.pinfo, nblk, self._bounds)
+            self._bounds_key = key
+        return self._bounds
 
     def _wall_pass(self) -> None:
         """Plane-wall contacts of the near-wall candidates (``walls.wall_forces``); sets each
