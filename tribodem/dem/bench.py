@@ -98,6 +98,7 @@ def run_case(name: str, n: int | None = None, steps: int | None = None,
         "particles": case.n,
         "steps": case.steps,
         "threads": numba.get_num_threads(),
+        "threading_layer": _threading_layer(),
         "seconds": dt_wall,
         "cpu_seconds": dt_cpu,  # all threads of this process (loaded machines: see this)
         "particle_steps_per_s": case.n * case.steps / dt_wall,
@@ -108,6 +109,15 @@ def run_case(name: str, n: int | None = None, steps: int | None = None,
         "dt_s": sim.dt,
         "memory": {**sim.memory(), **extra, "peak_rss_bytes": _peak_rss()},
     }
+
+
+def _threading_layer() -> str:
+    """numba's threading layer in use (``omp`` first, ``dem.jit``), or ``none`` if no
+    threaded region ran (one thread: every kernel on its serial build)."""
+    try:
+        return str(numba.threading_layer())
+    except ValueError:
+        return "none"
 
 
 def _peak_rss() -> float:
