@@ -84,6 +84,11 @@ _pairs_2d = pair_forces_sum_2d.serial
 _pairs_3d = pair_forces_sum.serial
 _walls_pass = wall_forces.serial
 _advance_serial = advance.serial
+# and their threaded builds (the loop of a large system on several threads)
+_cross_par = pair_forces_cross.parallel
+_blocked_par = pair_forces_blocked.parallel
+_walls_par = wall_forces.parallel
+_advance_par = advance.parallel
 _SERVO = WALL_MODES.index("servo")
 _BOUNDARY = WALL_MODES.index("boundary")
 
@@ -184,16 +189,20 @@ RUN_DONE, RUN_REBUILD, RUN_EVENT, RUN_UNSTABLE = 0, 1, 2, 3
 
 
 @numba.njit(cache=True)
-def _run_steps(c, states, nmax, step0, check_every, max_ratio):  # pragma: no cover
-    """Up to ``nmax`` steps of ``Simulation.step`` in one compiled loop (serial kernels,
-    the same operations in the same order, so the same bits): pair contacts -> the
+def _run_steps(c, states, nmax, step0, check_every, max_ratio, bounds):  # pragma: no cover
+    """Up to ``nmax`` steps of ``Simulation.step`` in one compiled loop (the same kernels,
+    operations and order as the Python loop, so the same bits): pair contacts -> the
     interactions' compiled steps (``states``, in order) -> wall pass and the walls'
     totals -> particle update -> wall motion -> clock. The first step starts at once (the
     caller has just checked the neighbour list); before each later one the rebuild test
     runs and, if due, the loop stops. After every step whose count (from ``step0``) is a
     multiple of ``check_every`` the stability test runs (``_unstable``) and stops the
-    loop if it fails. Returns (steps done, ``RUN_*`` reason, the OR of the interactions'
-    event codes)."""
+    loop if it fails. ``bounds``: ``None`` (a compile-time branch) runs every kernel's
+    serial build; an array runs their threaded builds, the pairs in those blocks
+    (``contact.pair_block_bounds``, cut again every ``REBALANCE_EVERY`` steps, in place),
+    with the caller's ``numba.parallel_chunksize`` (set inside, the loop could not be
+    cached: the setter is a ctypes pointer).
+    Returns (steps done, ``RUN_*`` reason, the OR of the interactions' event codes)."""
     nw = c.wall_point.shape[0]
     n = c.pos.shape[0]
     k = 0
@@ -202,14 +211,25 @@ def _run_steps(c, states, nmax, step0, check_every, max_ratio):  # pragma: no co
     t = c.clock[0]
     # the pairs' constants, once per call: no compiled step changes radii, masses or
     # materials, and the list is rebuilt only between calls
-    pconst = np.empty((c.pair_i.shape[0], N_PCONST))
-    pair_constants(c.radius, c.mass, c.inertia, c.mat, c.pair_i, c.pair_j, c.pairtab, c.elin,
-                   c.dim, c.thickness, pconst)
+    pconst = np.empty((c.pair_i.shape[0] if bounds is None else 0, N_PCONST))
+    if bounds is None:
+        pair_constants(c.radius, c.mass, c.inertia, c.mat, c.pair_i, c.pair_j, c.pairtab,
+                       c.elin, c.dim, c.thickness, pconst)
     while k < nmax:
         if k > 0 and _must_rebuild(c):
             why = RUN_REBUILD
             break
-        if c.dim == 2:
+        if bounds is not None:  # threaded: the blocked Newton pairs
+            if k > 0 and (step0 + k) % REBALANCE_EVERY == 0:
+                pair_block_bounds(c.start, c.pinfo, bounds.shape[0] - 1, bounds)
+            _cross_par(c.pos, c.vel, c.omega, c.radius, c.mass, c.inertia, c.mat, c.start,
+                       c.pair_j, c.hist, c.pairtab, c.elin, c.length, c.periodic, c.dim,
+                       c.thickness, c.dt, c.fpair, c.tpair_i, c.tpair_j, c.pinfo, bounds)
+            _blocked_par(c.pos, c.vel, c.omega, c.radius, c.mass, c.inertia, c.mat, c.start,
+                         c.pair_i, c.pair_j, c.rev_start, c.rev_pair, c.hist, c.pairtab,
+                         c.elin, c.length, c.periodic, c.dim, c.thickness, c.dt, c.fpair,
+                         c.tpair_i, c.tpair_j, c.pinfo, c.force, c.torque, bounds)
+        elif c.dim == 2:
             _pairs_2d(c.pos, c.vel, c.omega, c.radius, c.mass, c.inertia, c.mat, c.pair_i,
                       c.pair_j, c.hist, c.pairtab, c.elin, c.length, c.periodic, c.dim,
                       c.thickness, c.dt, c.fpair, c.tpair_i, c.tpair_j, c.pinfo, c.force,
@@ -227,18 +247,32 @@ def _run_steps(c, states, nmax, step0, check_every, max_ratio):  # pragma: no co
                     c.ext_torque[i, d] = 0.0
             ev = _interactions(states, c)
         if nw:
-            _walls_pass(c.pos, c.vel, c.omega, c.radius, c.mass, c.inertia, c.mat, c.wstart,
-                        c.wid, c.wpart, c.wbstart, c.wall_point, c.wall_normal, c.wall_vel,
-                        c.wall_mat, c.wall_hist, c.wall_info, c.wsum, c.pairtab, c.elin,
-                        c.dim, c.thickness, c.dt, c.wforce, c.wtorque, c.wall_tot)
+            if bounds is None:
+                _walls_pass(c.pos, c.vel, c.omega, c.radius, c.mass, c.inertia, c.mat,
+                            c.wstart, c.wid, c.wpart, c.wbstart, c.wall_point, c.wall_normal,
+                            c.wall_vel, c.wall_mat, c.wall_hist, c.wall_info, c.wsum,
+                            c.pairtab, c.elin, c.dim, c.thickness, c.dt, c.wforce, c.wtorque,
+                            c.wall_tot)
+            else:
+                _walls_par(c.pos, c.vel, c.omega, c.radius, c.mass, c.inertia, c.mat,
+                           c.wstart, c.wid, c.wpart, c.wbstart, c.wall_point, c.wall_normal,
+                           c.wall_vel, c.wall_mat, c.wall_hist, c.wall_info, c.wsum,
+                           c.pairtab, c.elin, c.dim, c.thickness, c.dt, c.wforce, c.wtorque,
+                           c.wall_tot)
             for w in range(nw):  # Simulation._wall_pass: the normal force on each wall
                 c.wall_nf[w] = -(c.wall_tot[w, 0] * c.wall_normal[w, 0]
                                  + c.wall_tot[w, 1] * c.wall_normal[w, 1]
                                  + c.wall_tot[w, 2] * c.wall_normal[w, 2])
-        _advance_serial(c.pos, c.vel, c.omega, c.radius, c.mass, c.inertia, c.fixed,
-                        c.wstart, c.wforce, c.wtorque, c.dt, c.gravity, c.viscous,
-                        c.local, c.has_ext, c.ext_force, c.ext_torque, c.force, c.torque,
-                        c.ref_pos, c.ref_radius, c.lo, c.length, c.periodic, c.drift)
+        if bounds is None:
+            _advance_serial(c.pos, c.vel, c.omega, c.radius, c.mass, c.inertia, c.fixed,
+                            c.wstart, c.wforce, c.wtorque, c.dt, c.gravity, c.viscous,
+                            c.local, c.has_ext, c.ext_force, c.ext_torque, c.force, c.torque,
+                            c.ref_pos, c.ref_radius, c.lo, c.length, c.periodic, c.drift)
+        else:
+            _advance_par(c.pos, c.vel, c.omega, c.radius, c.mass, c.inertia, c.fixed,
+                         c.wstart, c.wforce, c.wtorque, c.dt, c.gravity, c.viscous,
+                         c.local, c.has_ext, c.ext_force, c.ext_torque, c.force, c.torque,
+                         c.ref_pos, c.ref_radius, c.lo, c.length, c.periodic, c.drift)
         _move_walls(c)
         t += c.dt
         k += 1
@@ -519,6 +553,11 @@ class Simulation:
                 bounds)
         self._evaluated = True
 
+    def _threaded(self) -> bool:
+        """Do the compiled loop's kernels run their threaded builds (``jit.serial_run``
+        of the larger of the particle and pair counts)?"""
+        return not serial_run(max(self.p.n, self.nl.n_pairs), self._threads)
+
     def _block_bounds(self) -> np.ndarray:
         """The blocks of the threaded pair pass (``contact.pair_block_bounds``: equal pair
         work, ``BLOCKS_PER_THREAD`` per thread), cut again after a neighbour rebuild and
@@ -618,12 +657,13 @@ class Simulation:
 
     def _compiled_states(self) -> tuple | None:
         """The interactions' compiled states (in order, closed by ``NoStep``) if the next
-        steps can run in the compiled loop: every kernel on its serial build, the built-in
-        contact laws only, no ``after_advance`` hook, no energy tracking, and a compiled
-        form from every interaction; else ``None``."""
+        steps can run in the compiled loop: the built-in contact laws only, no
+        ``after_advance`` hook, no energy tracking, and a compiled form from every
+        interaction -- on threads only without interactions (their compiled steps are
+        serial; threaded, the Python loop runs their threaded kernels); else ``None``."""
         if (not self.compiled_loop or self.track_energy or self._after
                 or len(laws.modules()) != len(laws.BUILTIN)
-                or not serial_run(max(self.p.n, self.nl.n_pairs), self._threads)):
+                or (self.interactions and self._threaded())):
             return None
         states = []
         for inter in self.interactions:
@@ -670,8 +710,14 @@ class Simulation:
         for every, _ in self.recorders:
             limit = min(limit, every - self.step_count % every)
         c = self._context()
-        k, _why, _events = _run_steps(c, states, limit, self.step_count, self.check_every,
-                                      self.max_overlap_ratio)
+        if self._threaded():  # one block (or 256 particles) a time: uneven work
+            with numba.parallel_chunksize(1):
+                k, _why, _events = _run_steps(c, states, limit, self.step_count,
+                                              self.check_every, self.max_overlap_ratio,
+                                              self._block_bounds())
+        else:
+            k, _why, _events = _run_steps(c, states, limit, self.step_count,
+                                          self.check_every, self.max_overlap_ratio, None)
         self._evaluated = True
         rows = c.wall_tot.tolist()
         for w_id, w in enumerate(self.walls):
