@@ -9,9 +9,11 @@ import pytest
 from tribodem.dem import Box, Material, ParticleState, Simulation
 from tribodem.dem.bonds import (
     ParallelBonds,
+    bond_consts_3d,
     bond_csr,
     bond_forces,
     bond_forces_2d,
+    bond_forces_3d,
     bond_screen,
     gather_bonds,
     install_bonds_by_gap,
@@ -233,6 +235,65 @@ def test_threaded_and_serial_kernels_agree_bitwise() -> None:
     for a, b in zip(outs[0][1], outs[1][1], strict=True):
         assert np.array_equal(a, b)
     assert np.any(outs[0][1][-2] != 0.25)
+
+
+def test_3d_batch_kernel_matches_the_general_one() -> None:
+    """Spheres: ``bond_forces_3d`` (batches, SIMD lanes, screened strength test) gives
+    ``bond_forces``'s bits on serial summed and threaded stored passes, over several
+    steps with breaks in both modes, bonds broken before, a periodic axis, turned
+    normals and a few spins beyond the series (the general kernel's fallback)."""
+    rng = np.random.default_rng(11)
+    n, nb = 3000, 5000
+    pos = rng.uniform(0, 0.1, (n, 3))
+    vel = rng.normal(0, 1e-3, (n, 3))
+    omega = rng.normal(0, 1e-1, (n, 3))
+    omega[:20] = rng.normal(0, 1e2, (20, 3))  # |omega| dt ~ 1e-2 > WS_SERIES
+    radius = rng.uniform(0.8, 1.2, n) * R
+    i = rng.integers(0, n // 2, nb)
+    j = rng.integers(n // 2, n, nb)
+    d = pos[j] - pos[i]
+    d[:, 0] -= 0.1 * np.rint(d[:, 0] / 0.1)
+    nrm = d / np.linalg.norm(d, axis=1)[:, None] + rng.normal(0, 1e-3, (nb, 3))
+    nrm /= np.linalg.norm(nrm, axis=1)[:, None]
+    one = np.ones(nb)
+    rb, area, ib, jb = R * one, 1e-6 * one, 1e-13 * one, 2e-13 * one
+    kn, ks, tens, coh, tanphi = 5e11 * one, 3e11 * one, 2e3 * one, 3e3 * one, 0.1 * one
+    kc = bond_consts_3d(rb, area, ib, jb, kn, ks, tens, coh, tanphi)
+    length, periodic = np.array([0.1, 0.0, 0.0]), np.array([True, False, False])
+    gstart, gbond = bond_csr(i, j, n, by_bond=True)
+    mode0 = np.zeros(nb, np.int8)
+    mode0[::97] = 1
+    fs0 = rng.normal(0, 1e-4, (nb, 3))
+    mb0 = rng.normal(0, 1e-9, (nb, 3))
+    for summed in (True, False):
+        outs = []
+        for fast in (False, True):
+            arrays = [np.zeros(nb), fs0.copy(), mb0.copy(), np.zeros(nb), nrm.copy(),
+                      mode0.copy(), np.zeros(nb, np.int8), np.zeros((nb, 9)),
+                      np.zeros((nb, 3)), np.zeros((nb, 3)), np.zeros((nb, 3))]
+            ext = [np.full((n, 3), 0.25), np.full((n, 3), -0.5)]
+            nnew = 0
+            for _ in range(3):
+                if fast:
+                    build = bond_forces_3d.serial if summed else bond_forces_3d.parallel
+                    nnew += build(pos, vel, omega, radius, i, j, rb, area, ib, jb, kn, ks,
+                                  tens, coh, tanphi, *arrays, 1e-4, length, periodic, summed,
+                                  *ext, kc)
+                else:
+                    build = bond_forces.serial if summed else bond_forces.parallel
+                    nnew += build(pos, vel, omega, radius, i, j, rb, area, ib, jb, kn, ks,
+                                  tens, coh, tanphi, *arrays, 3, 1e-4, length, periodic,
+                                  summed, *ext)
+                if not summed:
+                    gather_bonds.parallel(gstart, gbond, i, arrays[5], *arrays[8:], *ext)
+            outs.append((nnew, arrays, ext))
+        (n1, a1, e1), (n2, a2, e2) = outs
+        modes = a1[5]
+        assert 0 < n1 == n2 < nb
+        assert np.any(modes == 1) and np.any(modes == 2)
+        for x, y in zip(a1 + e1, a2 + e2, strict=True):
+            assert np.array_equal(x, y)
+            assert np.array_equal(np.signbit(x), np.signbit(y))
 
 
 def _disk_bonds(rng: np.random.Generator, n: int, nb: int, box: float) -> tuple:
