@@ -115,6 +115,7 @@ def test_blocked_pair_sums_do_not_depend_on_the_cut() -> None:
     from tribodem.dem.bench_cases import settle3d_case
     from tribodem.dem.contact import (
         pair_block_bounds,
+        pair_cross_list,
         pair_forces_blocked,
         pair_forces_cross,
         pair_forces_sum,
@@ -142,10 +143,14 @@ def test_blocked_pair_sums_do_not_depend_on_the_cut() -> None:
             np.concatenate([[0], np.sort(rng.integers(0, p.n, 9)), [p.n]])]
     for bounds in cuts:
         h2, pi2, f2, ti2, tj2, force2, torque2 = common()
+        cross = np.zeros(nl.n_pairs, dtype=np.int64)
+        ncross = pair_cross_list(nl.pair_i, nl.pair_j, bounds, cross)
+        assert ncross == np.count_nonzero(np.searchsorted(bounds, nl.pair_i, "right")
+                                          != np.searchsorted(bounds, nl.pair_j, "right"))
         pair_forces_cross.parallel(p.pos, p.vel, p.omega, p.radius, p.mass, p.inertia, p.mat,
-                                   nl.start, nl.pair_j, h2, sim.pairtab, sim.elin,
+                                   nl.pair_i, nl.pair_j, h2, sim.pairtab, sim.elin,
                                    sim.box_length, sim.box.periodic, p.dim, p.thickness,
-                                   sim.dt, f2, ti2, tj2, pi2, bounds)
+                                   sim.dt, f2, ti2, tj2, pi2, cross, ncross)
         pair_forces_blocked.parallel(p.pos, p.vel, p.omega, p.radius, p.mass, p.inertia,
                                      p.mat, nl.start, nl.pair_i, nl.pair_j, nl.rev_start,
                                      nl.rev_pair, h2, sim.pairtab, sim.elin, sim.box_length,

@@ -474,69 +474,80 @@ def pair_block_bounds(start, pinfo, nblk, bounds):  # pragma: no cover - numba
     bounds[nblk] = n
 
 
-@kernel(chunk=1)
-def pair_forces_cross(pos, vel, omega, radius, mass, inertia, mat, start, pair_j, hist,
+@njit(cache=True)
+def pair_cross_list(pair_i, pair_j, bounds, out):  # pragma: no cover - numba
+    """The listed pairs whose two particles lie in different blocks of ``bounds``
+    (``pair_block_bounds``; i's block ends before j), in increasing pair index, into
+    ``out[:k]``; returns k. They close each sorted row."""
+    k = 0
+    blk = 0
+    for p in range(pair_i.shape[0]):
+        i = pair_i[p]
+        while i >= bounds[blk + 1]:
+            blk += 1
+        if pair_j[p] >= bounds[blk + 1]:
+            out[k] = p
+            k += 1
+    return k
+
+
+@kernel
+def pair_forces_cross(pos, vel, omega, radius, mass, inertia, mat, pair_i, pair_j, hist,
                       pairtab, elin, length, periodic, dim, thickness, dt, fpair, tpair_i,
-                      tpair_j, pinfo, bounds):
-    """First pass of the threaded Newton pairs: the pairs whose two particles lie in
-    different blocks (``bounds``, ``pair_block_bounds``; i's block ends before j: they
-    close each sorted row), stored with both torques (``fpair``, ``tpair_i``, ``tpair_j``,
-    ``pinfo``, the history). Threads take blocks (prange over blocks); each
-    writes only its own pairs' rows."""
-    nblk = bounds.shape[0] - 1
-    for blk in prange(nblk):
-        b1 = bounds[blk + 1]
-        for i in range(bounds[blk], b1):
-            p = start[i + 1] - 1
-            while p >= start[i] and pair_j[p] >= b1:
-                j = pair_j[p]
-                d0 = min_image(pos[j, 0] - pos[i, 0], length[0], periodic[0])
-                d1 = min_image(pos[j, 1] - pos[i, 1], length[1], periodic[1])
-                d2 = min_image(pos[j, 2] - pos[i, 2], length[2], periodic[2])
-                ri = radius[i]
-                rj = radius[j]
-                dist2 = d0 * d0 + d1 * d1 + d2 * d2
-                dist = np.sqrt(dist2)
-                delta = ri + rj - dist
-                if not (delta > 0.0 and dist2 > 0.0):  # apart: clear a contact just ended
-                    if pinfo[p, 0] > 0.0:
-                        for k in range(3):
-                            hist[p, k] = 0.0
-                            fpair[p, k] = 0.0
-                            tpair_i[p, k] = 0.0
-                            tpair_j[p, k] = 0.0
-                        pinfo[p, 1] = 0.0
-                        pinfo[p, 2] = 0.0
-                        pinfo[p, 3] = 0.0
-                    pinfo[p, 0] = delta
-                    p -= 1
-                    continue
-                prop = pairtab[mat[i], mat[j]]
-                lin_k, rstar, mstar, istar = _pair_consts(
-                    prop, ri, rj, mass[i], mass[j], inertia[i], inertia[j], elin[mat[i]],
-                    elin[mat[j]], dim, thickness)
-                (f0, f1, f2, a0, a1, a2, b0, b1_, b2, delta, fn, energy, kn, h0, h1,
-                 h2) = _pair(d0, d1, d2, dist, ri, rj, vel[i, 0], vel[i, 1], vel[i, 2],
-                             vel[j, 0], vel[j, 1], vel[j, 2], omega[i, 0], omega[i, 1],
-                             omega[i, 2], omega[j, 0], omega[j, 1], omega[j, 2], rstar, mstar,
-                             istar, prop, lin_k, hist[p, 0], hist[p, 1], hist[p, 2], dt)
-                hist[p, 0] = h0
-                hist[p, 1] = h1
-                hist[p, 2] = h2
-                fpair[p, 0] = f0
-                fpair[p, 1] = f1
-                fpair[p, 2] = f2
-                tpair_i[p, 0] = a0
-                tpair_i[p, 1] = a1
-                tpair_i[p, 2] = a2
-                tpair_j[p, 0] = b0
-                tpair_j[p, 1] = b1_
-                tpair_j[p, 2] = b2
-                pinfo[p, 0] = delta
-                pinfo[p, 1] = fn
-                pinfo[p, 2] = energy
-                pinfo[p, 3] = kn
-                p -= 1
+                      tpair_j, pinfo, cross, ncross):
+    """First pass of the threaded Newton pairs: the pairs across blocks (``cross[:ncross]``,
+    ``pair_cross_list``), stored with both torques (``fpair``, ``tpair_i``, ``tpair_j``,
+    ``pinfo``, the history). Threads take equal shares of the list (prange over it: the
+    cross pairs crowd at a few block boundaries); each writes only its own pairs' rows."""
+    for q in prange(ncross):
+        p = cross[q]
+        i = pair_i[p]
+        j = pair_j[p]
+        d0 = min_image(pos[j, 0] - pos[i, 0], length[0], periodic[0])
+        d1 = min_image(pos[j, 1] - pos[i, 1], length[1], periodic[1])
+        d2 = min_image(pos[j, 2] - pos[i, 2], length[2], periodic[2])
+        ri = radius[i]
+        rj = radius[j]
+        dist2 = d0 * d0 + d1 * d1 + d2 * d2
+        dist = np.sqrt(dist2)
+        delta = ri + rj - dist
+        if not (delta > 0.0 and dist2 > 0.0):  # apart: clear a contact just ended
+            if pinfo[p, 0] > 0.0:
+                for k in range(3):
+                    hist[p, k] = 0.0
+                    fpair[p, k] = 0.0
+                    tpair_i[p, k] = 0.0
+                    tpair_j[p, k] = 0.0
+                pinfo[p, 1] = 0.0
+                pinfo[p, 2] = 0.0
+                pinfo[p, 3] = 0.0
+            pinfo[p, 0] = delta
+            continue
+        prop = pairtab[mat[i], mat[j]]
+        lin_k, rstar, mstar, istar = _pair_consts(
+            prop, ri, rj, mass[i], mass[j], inertia[i], inertia[j], elin[mat[i]],
+            elin[mat[j]], dim, thickness)
+        (f0, f1, f2, a0, a1, a2, b0, b1, b2, delta, fn, energy, kn, h0, h1,
+         h2) = _pair(d0, d1, d2, dist, ri, rj, vel[i, 0], vel[i, 1], vel[i, 2],
+                     vel[j, 0], vel[j, 1], vel[j, 2], omega[i, 0], omega[i, 1],
+                     omega[i, 2], omega[j, 0], omega[j, 1], omega[j, 2], rstar, mstar,
+                     istar, prop, lin_k, hist[p, 0], hist[p, 1], hist[p, 2], dt)
+        hist[p, 0] = h0
+        hist[p, 1] = h1
+        hist[p, 2] = h2
+        fpair[p, 0] = f0
+        fpair[p, 1] = f1
+        fpair[p, 2] = f2
+        tpair_i[p, 0] = a0
+        tpair_i[p, 1] = a1
+        tpair_i[p, 2] = a2
+        tpair_j[p, 0] = b0
+        tpair_j[p, 1] = b1
+        tpair_j[p, 2] = b2
+        pinfo[p, 0] = delta
+        pinfo[p, 1] = fn
+        pinfo[p, 2] = energy
+        pinfo[p, 3] = kn
 
 
 @kernel(chunk=1)

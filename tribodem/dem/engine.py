@@ -39,6 +39,7 @@ from tribodem.dem.contact import (
     Material,
     pair_block_bounds,
     pair_constants,
+    pair_cross_list,
     pair_forces_blocked,
     pair_forces_cross,
     pair_forces_sum,
@@ -193,7 +194,8 @@ RUN_DONE, RUN_REBUILD, RUN_EVENT, RUN_UNSTABLE = 0, 1, 2, 3
 
 
 @numba.njit(cache=True)
-def _run_steps(c, states, nmax, step0, check_every, max_ratio, bounds):  # pragma: no cover
+def _run_steps(c, states, nmax, step0, check_every, max_ratio, bounds, xpairs,
+               nx):  # pragma: no cover
     """Up to ``nmax`` steps of ``Simulation.step`` in one compiled loop (the same kernels,
     operations and order as the Python loop, so the same bits): pair contacts -> the
     interactions' compiled steps (``states``, in order) -> wall pass and the walls'
@@ -203,7 +205,8 @@ def _run_steps(c, states, nmax, step0, check_every, max_ratio, bounds):  # pragm
     multiple of ``check_every`` the stability test runs (``_unstable``) and stops the
     loop if it fails. ``bounds``: ``None`` (a compile-time branch) runs every kernel's
     serial build; an array runs their threaded builds, the pairs in those blocks
-    (``contact.pair_block_bounds``, cut again every ``REBALANCE_EVERY`` steps, in place),
+    (``contact.pair_block_bounds``) with the pairs across them in ``xpairs[:nx[0]]``
+    (``contact.pair_cross_list``), both cut again every ``REBALANCE_EVERY`` steps, in place,
     with the caller's ``numba.parallel_chunksize`` (set inside, the loop could not be
     cached: the setter is a ctypes pointer).
     Returns (steps done, ``RUN_*`` reason, the OR of the interactions' event codes)."""
@@ -226,9 +229,11 @@ def _run_steps(c, states, nmax, step0, check_every, max_ratio, bounds):  # pragm
         if bounds is not None:  # threaded: the blocked Newton pairs
             if k > 0 and (step0 + k) % REBALANCE_EVERY == 0:
                 pair_block_bounds(c.start, c.pinfo, bounds.shape[0] - 1, bounds)
-            _cross_par(c.pos, c.vel, c.omega, c.radius, c.mass, c.inertia, c.mat, c.start,
+                nx[0] = pair_cross_list(c.pair_i, c.pair_j, bounds, xpairs)
+            _cross_par(c.pos, c.vel, c.omega, c.radius, c.mass, c.inertia, c.mat, c.pair_i,
                        c.pair_j, c.hist, c.pairtab, c.elin, c.length, c.periodic, c.dim,
-                       c.thickness, c.dt, c.fpair, c.tpair_i, c.tpair_j, c.pinfo, bounds)
+                       c.thickness, c.dt, c.fpair, c.tpair_i, c.tpair_j, c.pinfo, xpairs,
+                       nx[0])
             _blocked_par(c.pos, c.vel, c.omega, c.radius, c.mass, c.inertia, c.mat, c.start,
                          c.pair_i, c.pair_j, c.rev_start, c.rev_pair, c.hist, c.pairtab,
                          c.elin, c.length, c.periodic, c.dim, c.thickness, c.dt, c.fpair,
@@ -370,7 +375,9 @@ class Simulation:
         self._threads: int | None = None  # numba threads, read once per step() call
         self._cross = np.zeros(0)  # cross_group_force's buffer
         self._bounds = np.zeros(0, dtype=np.int64)  # the threaded pair pass's blocks
-        self._bounds_key: tuple = ()
+        self._bounds_key: tuple = (None, 0, False)
+        self._xpairs = np.zeros(0, dtype=np.int64)  # the pairs across those blocks
+        self._nx = np.zeros(1, dtype=np.int64)  # how many
         #: ``box.length`` as of the current ``step()`` call (read once per call by the
         #: kernels and interactions; a box changed between calls is seen at the next)
         self.box_length = self.box.length
@@ -545,10 +552,10 @@ class Simulation:
             nl = self.nl
             bounds = self._block_bounds()
             laws.active(pair_forces_cross).pick(nl.n_pairs, self._threads)(
-                p.pos, p.vel, p.omega, p.radius, p.mass, p.inertia, p.mat, nl.start,
+                p.pos, p.vel, p.omega, p.radius, p.mass, p.inertia, p.mat, nl.pair_i,
                 nl.pair_j, self.hist, self.pairtab, self.elin, self.box_length,
                 self.box.periodic, p.dim, p.thickness, self.dt, self.fpair, self.tpair_i,
-                self.tpair_j, self.pinfo, bounds)
+                self.tpair_j, self.pinfo, self._xpairs, int(self._nx[0]))
             laws.active(pair_forces_blocked).pick(nl.n_pairs, self._threads)(
                 p.pos, p.vel, p.omega, p.radius, p.mass, p.inertia, p.mat, nl.start,
                 nl.pair_i, nl.pair_j, nl.rev_start, nl.rev_pair, self.hist, self.pairtab,
@@ -564,16 +571,22 @@ class Simulation:
 
     def _block_bounds(self) -> np.ndarray:
         """The blocks of the threaded pair pass (``contact.pair_block_bounds``: equal pair
-        work, ``BLOCKS_PER_THREAD`` per thread), cut again after a neighbour rebuild and
+        work, ``BLOCKS_PER_THREAD`` per thread; the pairs across them into ``_xpairs[:_nx[0]]``,
+        ``contact.pair_cross_list``), cut again after a neighbour rebuild and
         every ``REBALANCE_EVERY`` steps as contacts move (no result depends on them). A
         cut made on a new list (whose ``pinfo`` holds placeholders) is made again once
         the list has been evaluated."""
         nblk = BLOCKS_PER_THREAD * max(self._threads or numba.get_num_threads(), 1)
-        key = (id(self.nl), nblk, self._evaluated)
-        if key != self._bounds_key or self.step_count % REBALANCE_EVERY == 0:
+        key = (self.nl, nblk, self._evaluated)  # the list itself: ids can be reused
+        if (key[0] is not self._bounds_key[0] or key[1:] != self._bounds_key[1:]
+                or self.step_count % REBALANCE_EVERY == 0):
             if self._bounds.shape[0] != nblk + 1:
                 self._bounds = np.zeros(nblk + 1, dtype=np.int64)
+            if self._xpairs.shape[0] != self.nl.n_pairs:
+                self._xpairs = np.zeros(self.nl.n_pairs, dtype=np.int64)
             pair_block_bounds(self.nl.start, self.pinfo, nblk, self._bounds)
+            self._nx[0] = pair_cross_list(self.nl.pair_i, self.nl.pair_j, self._bounds,
+                                          self._xpairs)
             self._bounds_key = key
         return self._bounds
 
@@ -718,10 +731,11 @@ class Simulation:
             with numba.parallel_chunksize(THREADED_CHUNK):
                 k, _why, _events = _run_steps(c, states, limit, self.step_count,
                                               self.check_every, self.max_overlap_ratio,
-                                              self._block_bounds())
+                                              self._block_bounds(), self._xpairs, self._nx)
         else:
             k, _why, _events = _run_steps(c, states, limit, self.step_count,
-                                          self.check_every, self.max_overlap_ratio, None)
+                                          self.check_every, self.max_overlap_ratio, None,
+                                          None, None)
         self._evaluated = True
         rows = c.wall_tot.tolist()
         for w_id, w in enumerate(self.walls):
