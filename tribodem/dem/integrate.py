@@ -46,24 +46,9 @@ def drift_of(pos, ref_pos, radius, ref_radius, i, length, periodic):
 
 @njit(cache=True, inline="always")
 def _update(pos, vel, omega, i, f0, f1, f2, t0, t1, t2, m, inertia, fixed, a, b, local, dt):
-    """Central-difference update of particle i for force f and moment t (seed 000 eqs 4, 7);
-    scalars, so the sums stay in registers."""
-    if fixed == 0 and local == 0.0:  # the common case: no fixity, no local damping
-        bm = b / m
-        v0 = a * vel[i, 0] + bm * f0
-        v1 = a * vel[i, 1] + bm * f1
-        v2 = a * vel[i, 2] + bm * f2
-        vel[i, 0] = v0
-        vel[i, 1] = v1
-        vel[i, 2] = v2
-        bi = b / inertia
-        omega[i, 0] = a * omega[i, 0] + bi * t0
-        omega[i, 1] = a * omega[i, 1] + bi * t1
-        omega[i, 2] = a * omega[i, 2] + bi * t2
-        pos[i, 0] += v0 * dt
-        pos[i, 1] += v1 * dt
-        pos[i, 2] += v2 * dt
-        return
+    """Central-difference update of particle i for force f and moment t (seed 000 eqs 4, 7)
+    with DOF fixity and PFC local damping; scalars, so the sums stay in registers. A free
+    particle without local damping takes ``advance``'s own written-out paths instead."""
     for k in range(3):
         if fixed & (1 << k):
             continue
@@ -143,9 +128,9 @@ def advance(pos, vel, omega, radius, mass, inertia, fixed, wstart, wforce, wtorq
                 pos[i, 1] += vel[i, 1] * dt
                 pos[i, 2] += vel[i, 2] * dt
             elif fx == 0 and local == 0.0:
-                # a free sphere: ``_update``'s common path written out, every load before
-                # the first store (through the inlined call, with the arrays handed to it,
-                # the serial build ran 1.8x slower; the same bits)
+                # a free sphere (no fixity, no local damping), written out with every load
+                # before the first store (through the inlined ``_update``, with the arrays
+                # handed to it, the serial build ran 1.8x slower)
                 bm = b / m
                 v0 = a * vel[i, 0] + bm * (f0 + m * g0)
                 v1 = a * vel[i, 1] + bm * (f1 + m * g1)
