@@ -16,45 +16,27 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
-import resource
-import subprocess
 import sys
 import time
 from pathlib import Path
 
+from peers import _run_measured, machine_busy  # benchmarks/ is this script's sys.path[0]
+
 ROOT = Path(__file__).resolve().parents[1]
 
 
-def _cpu_ticks() -> tuple[int, int]:
-    """(all ticks, idle + iowait ticks) of the machine so far (``/proc/stat``)."""
-    v = [int(x) for x in Path("/proc/stat").read_text().split("\n", 1)[0].split()[1:]]
-    return sum(v), v[3] + v[4]
-
-
 def _others(cmd: list[str]) -> tuple[str, float]:
-    """Run ``cmd``; its stdout and the share of the machine's CPU time that other processes
-    used meanwhile (0..1)."""
-    t0, i0 = _cpu_ticks()
-    r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
-    out = subprocess.run(cmd, capture_output=True, text=True, cwd=ROOT, check=True).stdout
-    t1, i1 = _cpu_ticks()
-    r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
-    own = (r1.ru_utime + r1.ru_stime - r0.ru_utime - r0.ru_stime) * os.sysconf("SC_CLK_TCK")
-    total = t1 - t0
-    busy = total - (i1 - i0)
-    return out, max(0.0, (busy - own) / total) if total else 0.0
+    """Run ``cmd``; its stdout and the share of the machine's CPUs that other processes used
+    meanwhile (0..1; ``peers._run_measured``)."""
+    proc, others = _run_measured(cmd, capture_output=True, text=True, cwd=ROOT, check=True)
+    return proc.stdout, others
 
 
 def _wait_idle(limit_s: float) -> None:
-    """Wait until other processes use < 15 % of the CPUs over 0.5 s (``limit_s`` at most)."""
+    """Wait until the machine's CPUs are < 15 % busy over 0.5 s (``limit_s`` at most)."""
     end = time.monotonic() + limit_s
-    while time.monotonic() < end:
-        t0, i0 = _cpu_ticks()
-        time.sleep(0.5)
-        t1, i1 = _cpu_ticks()
-        if t1 > t0 and (t1 - t0 - (i1 - i0)) / (t1 - t0) < 0.15:
-            return
+    while time.monotonic() < end and machine_busy(0.5) >= 0.15:
+        pass
 
 
 def _rate(out: str) -> float:
