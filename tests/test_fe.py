@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import math
 import shutil
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -137,9 +138,42 @@ def test_missing_ccx_names_the_install_command(tmp_path: Path,
     with pytest.raises(CcxNotFoundError, match="apt-get install -y calculix-ccx"):
         run_ccx(deck, executable="ccx-not-installed-here")
     monkeypatch.setenv("PATH", "")
+    monkeypatch.setenv("TRIBODEM_CCX", "ccx")  # not a PARDISO build beside this Python either
     with pytest.raises(CcxNotFoundError) as exc:
         run_ccx(deck)
     assert INSTALL_COMMAND in str(exc.value)
+
+
+def test_which_ccx_runs(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """resolve_ccx: the caller's name, else $TRIBODEM_CCX, else ccx_pardiso (PATH, then
+    this Python's bin), else ccx; ccx_solvers reads the solvers built into a binary."""
+    from tribodem.contact.fe import ccx_solvers, resolve_ccx
+
+    bin_dir, prefix = tmp_path / "bin", tmp_path / "prefix"
+    (prefix / "bin").mkdir(parents=True)
+    bin_dir.mkdir()
+    for name, text in (("ccx", "using the unsymmetric spooles solver"),
+                       ("ccx_pardiso", "using the unsymmetric pardiso solver\0"
+                                       "using the unsymmetric spooles solver")):
+        exe = bin_dir / name
+        exe.write_text(f"#!/bin/sh\n# {text}\n")
+        exe.chmod(0o755)
+    monkeypatch.setenv("PATH", str(bin_dir))
+    monkeypatch.delenv("TRIBODEM_CCX", raising=False)
+    monkeypatch.setattr(sys, "prefix", str(prefix))
+    assert resolve_ccx() == str(bin_dir / "ccx_pardiso")
+    assert ccx_solvers(str(bin_dir / "ccx_pardiso")) == ["PARDISO", "SPOOLES"]
+    assert ccx_solvers(str(bin_dir / "ccx")) == ["SPOOLES"]
+    monkeypatch.setenv("TRIBODEM_CCX", "ccx")
+    assert resolve_ccx() == str(bin_dir / "ccx")
+    assert resolve_ccx("ccx_pardiso") == str(bin_dir / "ccx_pardiso")  # the caller's wins
+    monkeypatch.delenv("TRIBODEM_CCX")
+    (bin_dir / "ccx_pardiso").rename(prefix / "bin" / "ccx_pardiso")  # beside this Python
+    assert resolve_ccx() == str(prefix / "bin" / "ccx_pardiso")
+    (prefix / "bin" / "ccx_pardiso").unlink()
+    assert resolve_ccx() == str(bin_dir / "ccx")
+    monkeypatch.setenv("TRIBODEM_CCX", str(tmp_path / "nowhere" / "ccx"))
+    assert resolve_ccx() is None
 
 
 # --- with ccx ---------------------------------------------------------------------------------
@@ -190,10 +224,17 @@ def test_bad_deck_raises_ccx_error_with_message(tmp_path: Path) -> None:
     assert "*ERROR" in exc.value.message and "NOSET" in exc.value.message
     assert exc.value.deck == deck.resolve() and str(deck.resolve()) in str(exc.value)
     assert not isinstance(exc.value, CcxConvergenceError)
-    # a crash without an *ERROR line (no elastic constants) is still an error, with the log
+    # no elastic constants: SPOOLES builds crash without an *ERROR line, PARDISO builds stop
+    # with "too many cutbacks"; an error either way
     deck.write_text(deck.read_text().replace("NOSET", "LBOT").replace("*ELASTIC\n", "*ELASTIK\n"))
-    with pytest.raises(CcxError, match="no 'Job finished'"):
+    with pytest.raises(CcxError):
         run_ccx(deck, timeout=60)
+    # a ccx that exits 0 without "Job finished" and without an *ERROR line is an error too
+    fake = tmp_path / "fake_ccx"
+    fake.write_text("#!/bin/sh\necho 'some output'\n")
+    fake.chmod(0o755)
+    with pytest.raises(CcxError, match="no 'Job finished'"):
+        run_ccx(deck, timeout=60, executable=str(fake))
 
 
 @needs_ccx

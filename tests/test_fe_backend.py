@@ -248,7 +248,8 @@ def test_ccx_failure_stops_the_run_with_exit_3(tmp_path: Path) -> None:
     cfg = tmp_path / "fe.toml"
     cfg.write_text(CONFIG)
     out = tmp_path / "run"
-    env = dict(os.environ, PATH=f"{bin_dir}{os.pathsep}{os.environ['PATH']}")
+    env = dict(os.environ, PATH=f"{bin_dir}{os.pathsep}{os.environ['PATH']}",
+               TRIBODEM_CCX="ccx")  # the wrapper, not a PARDISO build
     r = run_tribodem("fretting", "run", "--config", str(cfg), "--out", str(out),
                      "--no-progress", env=env)
     assert r.returncode == 3, r.stderr
@@ -274,7 +275,7 @@ def test_ccx_failure_stops_the_run_with_exit_3(tmp_path: Path) -> None:
 def test_missing_ccx_exits_2_with_the_install_command(tmp_path: Path) -> None:
     cfg = tmp_path / "fe.toml"
     cfg.write_text(CONFIG)
-    env = dict(os.environ, PATH=str(tmp_path / "nowhere"))
+    env = dict(os.environ, PATH=str(tmp_path / "nowhere"), TRIBODEM_CCX="ccx")
     r = run_tribodem("fretting", "run", "--config", str(cfg), "--out", str(tmp_path / "run"),
                      "--no-progress", env=env)
     assert r.returncode == 2, r.stderr

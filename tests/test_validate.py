@@ -25,7 +25,7 @@ def test_halfspace_passes_every_closed_form_check() -> None:
 
 
 def test_fe_without_ccx_exits_2_with_the_install_command() -> None:
-    env = {**os.environ, "PATH": "/nonexistent"}
+    env = {**os.environ, "PATH": "/nonexistent", "TRIBODEM_CCX": "ccx"}
     r = run_tribodem("validate", "--solver", "fe", env=env)
     assert r.returncode == 2 and "apt-get install -y calculix-ccx" in r.stderr
     assert "Traceback" not in r.stderr

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import json
-import shutil
 import tempfile
 from pathlib import Path
 from typing import Annotated
@@ -35,7 +34,9 @@ def validate(
     if solver not in SOLVERS:
         raise ConfigError(f"--solver = {solver!r}: allowed: {', '.join(SOLVERS)}")
     if solver == "fe":
-        if shutil.which("ccx") is None:
+        from tribodem.contact.fe.ccx import resolve_ccx
+
+        if resolve_ccx() is None:
             raise ConfigError("--solver = 'fe' needs CalculiX's ccx, which is not on PATH; "
                               "install it with: apt-get install -y calculix-ccx")
         from tribodem.contact.fe.validate import validate_fe
@@ -66,15 +67,19 @@ def validate(
 
 
 def ccx_version() -> str:
-    """The CalculiX ``ccx`` found on PATH (its version line), or how to install it."""
+    """The CalculiX ``ccx`` the finite-element backends run (``resolve_ccx``: its path,
+    version line and direct solvers), or how to install it."""
     import subprocess
 
-    exe = shutil.which("ccx")
+    from tribodem.contact.fe.ccx import INSTALL_COMMAND, ccx_solvers, resolve_ccx
+
+    exe = resolve_ccx()
     if exe is None:
-        return "ccx: not found (apt-get install -y calculix-ccx)"
+        return f"ccx: not found ({INSTALL_COMMAND})"
+    solvers = ", ".join(ccx_solvers(exe)) or "solvers unknown"
     try:
         out = subprocess.run([exe, "-v"], capture_output=True, text=True, timeout=10).stdout
     except (OSError, subprocess.TimeoutExpired):
-        return f"ccx: {exe} (version unknown)"
+        return f"ccx: {exe} (version unknown; {solvers})"
     line = next((x.strip() for x in out.splitlines() if "Version" in x), "version unknown")
-    return f"ccx: {exe} ({line})"
+    return f"ccx: {exe} ({line}; {solvers})"

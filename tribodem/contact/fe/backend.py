@@ -218,7 +218,7 @@ class FEContactSolver(CcxJobs, FirstBodySolver):
         retries: int = 1,
         cache: str | Path | None = None,
         workdir: str | Path | None = None,
-        executable: str = "ccx",
+        executable: str | None = None,
         stress_depth: float | None = None,
         regime: str = "gross",
         tolerance: float | None = None,

@@ -1,7 +1,8 @@
 """Run CalculiX ``ccx`` as a subprocess with a wall-clock limit and clear failures.
 
 * The job runs in its folder (deck, log ``<job>.log``, ``.sta``, ``.dat``, ``.frd`` kept).
-* ``threads`` sets ``OMP_NUM_THREADS`` and ``CCX_NPROC_EQUATION_SOLVER``.
+* ``threads`` sets ``OMP_NUM_THREADS``, ``CCX_NPROC_EQUATION_SOLVER`` and
+  ``MKL_NUM_THREADS`` (PARDISO builds).
 * A run longer than ``timeout`` seconds is killed (its whole process group) and raises
   :class:`CcxTimeoutError` (a bad contact setup can make ccx iterate for ever); ccx is also
   killed on Ctrl-C, and on Linux when the Python process dies (``PR_SET_PDEATHSIG``).
@@ -9,6 +10,10 @@
   :class:`CcxError` (:class:`CcxConvergenceError` when ccx reports divergence or too many
   cutbacks) carrying the ccx message, the deck path and the last ``.sta`` line.
 * No ``ccx`` executable raises :class:`CcxNotFoundError` naming the install command.
+* Which ccx (:func:`resolve_ccx`): the one named by the caller, else ``$TRIBODEM_CCX``, else
+  ``ccx_pardiso`` (the PARDISO build of ``tools/build_ccx_pardiso``, on PATH or beside this
+  Python), else ``ccx`` on PATH (Debian's calculix-ccx: SPOOLES only). The decks are the
+  same for every build: ccx uses PARDISO as its default solver when it is built in.
 """
 
 from __future__ import annotations
@@ -24,6 +29,10 @@ from pathlib import Path
 
 #: the one command that installs the solver (Debian/Ubuntu package of CalculiX 2.20)
 INSTALL_COMMAND = "apt-get install -y calculix-ccx"
+#: environment variable naming the ccx to run (a name on PATH or a path)
+CCX_ENV = "TRIBODEM_CCX"
+#: the executable ``tools/build_ccx_pardiso`` installs (ccx 2.20 with MKL's PARDISO)
+PARDISO_NAME = "ccx_pardiso"
 
 _CONVERGENCE_WORDS = ("diverge", "cutback", "too many iterations", "increment size smaller",
                       "no convergence", "not converge")
@@ -77,14 +86,41 @@ class CcxRun:
         return self.job.with_suffix(".frd")
 
 
-def find_ccx(executable: str = "ccx") -> str:
-    """Absolute path of ``executable`` on PATH, else :class:`CcxNotFoundError`."""
-    path = shutil.which(executable)
+def resolve_ccx(executable: str | None = None) -> str | None:
+    """Path of the ccx to run, or None when there is none: ``executable`` (a name on PATH or
+    a path) if given; else ``$TRIBODEM_CCX``; else ``ccx_pardiso`` on PATH or in this
+    Python's ``bin`` folder (``tools/build_ccx_pardiso``); else ``ccx`` on PATH."""
+    if executable is None:
+        executable = os.environ.get(CCX_ENV) or None
+    if executable is not None:
+        return shutil.which(executable)
+    for cand in (shutil.which(PARDISO_NAME), str(Path(sys.prefix) / "bin" / PARDISO_NAME)):
+        if cand and Path(cand).is_file() and os.access(cand, os.X_OK):
+            return cand
+    return shutil.which("ccx")
+
+
+def find_ccx(executable: str | None = None) -> str:
+    """Absolute path of the ccx :func:`resolve_ccx` picks, else :class:`CcxNotFoundError`
+    naming the install command."""
+    path = resolve_ccx(executable)
     if path is None:
+        what = executable or os.environ.get(CCX_ENV) or "ccx"
         raise CcxNotFoundError(
-            f"CalculiX solver '{executable}' not found on PATH; install it with: "
+            f"CalculiX solver '{what}' not found on PATH; install it with: "
             f"{INSTALL_COMMAND}")
     return path
+
+
+def ccx_solvers(path: str) -> list[str]:
+    """The direct solvers built into the ccx at ``path`` (``PARDISO``, ``SPOOLES``), read
+    from the messages in the binary; the first is the one ccx uses by default."""
+    try:
+        data = Path(path).read_bytes()
+    except OSError:
+        return []
+    return [name for name in ("PARDISO", "SPOOLES")
+            if f"using the unsymmetric {name.lower()} solver".encode() in data]
 
 
 def _last_sta_line(job: Path) -> str:
@@ -133,7 +169,7 @@ def _kill(proc: subprocess.Popen[bytes]) -> None:
 
 
 def run_ccx(deck: str | Path, threads: int = 1, timeout: float = 600.0,
-            executable: str = "ccx") -> CcxRun:
+            executable: str | None = None) -> CcxRun:
     """Run ``ccx -i <job>`` in the deck's folder; see the module docstring for failures."""
     deck = Path(deck).resolve()
     if deck.suffix != ".inp" or not deck.exists():
@@ -141,7 +177,7 @@ def run_ccx(deck: str | Path, threads: int = 1, timeout: float = 600.0,
     exe = find_ccx(executable)
     job = deck.with_suffix("")
     env = dict(os.environ, OMP_NUM_THREADS=str(int(threads)),
-               CCX_NPROC_EQUATION_SOLVER=str(int(threads)))
+               CCX_NPROC_EQUATION_SOLVER=str(int(threads)), MKL_NUM_THREADS=str(int(threads)))
     log_path = job.with_suffix(".log")
     t0 = time.perf_counter()
     with open(log_path, "w") as log_file:

@@ -23,7 +23,13 @@ from numpy.typing import NDArray
 
 from tribodem.contact.base import ElasticBody, IncrementResult, Unsupported, _check_positive
 from tribodem.contact.elastoplastic import PlasticStep
-from tribodem.contact.fe.ccx import CcxConvergenceError, CcxRun, FESolverStopped, run_ccx
+from tribodem.contact.fe.ccx import (
+    CcxConvergenceError,
+    CcxRun,
+    FESolverStopped,
+    resolve_ccx,
+    run_ccx,
+)
 from tribodem.contact.fe.deck import FEMaterial
 from tribodem.io.results import write_csv
 
@@ -64,7 +70,7 @@ def _cache_key(deck: Path, executable: str | None) -> str:
     """The deck's bytes and the ccx executable (path, size, mtime): equal keys, equal
     results (ccx is deterministic for a given deck and build)."""
     h = hashlib.sha256(deck.read_bytes())
-    exe = shutil.which(executable or "ccx")
+    exe = resolve_ccx(executable)
     if exe:
         st = Path(exe).stat()
         h.update(f"{exe}|{st.st_size}|{st.st_mtime_ns}".encode())

@@ -80,7 +80,7 @@ def build(case: LineCase, folder: str | Path, name: str = "job", fine_stress: bo
 
 def run_line_case(case: LineCase, folder: str | Path, threads: int = 1,
                   timeout: float = 600.0, fine_stress: bool = True, frd: bool = False,
-                  executable: str = "ccx") -> LineRun:
+                  executable: str | None = None) -> LineRun:
     """Build, solve with ccx (wall-clock ``timeout`` s) and read one case."""
     t0 = time.perf_counter()
     mesh, deck = build(case, folder, fine_stress=fine_stress, frd=frd)
