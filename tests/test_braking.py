@@ -10,7 +10,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tribodem.braking.compare import change_with_error, step_verdict, trend_verdict
+from tribodem.braking.compare import (
+    change_with_error,
+    packings_for,
+    step_verdict,
+    trend_verdict,
+)
 from tribodem.braking.conditions import (
     CONDITIONS,
     FRICTION_RADIUS_M,
@@ -158,6 +163,19 @@ def test_change_errors_and_verdicts() -> None:
     assert trend_verdict([(10, 2), (-10, 2)], (1, 3), "up").startswith("not resolved")
     assert trend_verdict([(-10, 2), (-10, 2)], (-20, 3), "up").startswith("not reproduced")
     assert trend_verdict([(-10, 2), (-10, 2)], (-20, 3), "down").startswith("reproduced")
+
+
+def test_packings_for_a_target_interval() -> None:
+    """The smallest m with t(0.975, m - 1) sd / sqrt(m) <= 10 pp, sd = se sqrt(n) kept."""
+    from scipy.stats import t
+
+    sd = 52.0  # pp: the 13 -> 21 kN per-packing change measured over 60 packings
+    m = packings_for(sd / np.sqrt(60), 60)
+    assert t.ppf(0.975, m - 1) * sd / np.sqrt(m) <= 10.0 < t.ppf(0.975, m - 2) * sd / np.sqrt(m - 1)
+    assert 100 <= m <= 110  # (1.96 x 52 / 10)^2 = 104 for large m
+    assert packings_for(0.1, 20) == 2  # far inside: the fewest that measure a scatter
+    assert packings_for(1.0, 20) == 4  # t(0.975, 3) = 3.18: 3.18 x 4.47 / 2 = 7.1 pp
+    assert packings_for(float("nan"), 1) is None
     # with 3 seeds a change must exceed t(0.975, 2) = 4.30 standard errors
     assert step_verdict(10.0, 4.0) == "up" and step_verdict(10.0, 4.0, 3) == "not resolved"
     assert step_verdict(10.0, 2.0, 3) == "up"

@@ -133,6 +133,26 @@ def ci95(se: float, n: int) -> float:
     return _factor(n) * se if np.isfinite(se) and n >= 2 else float("nan")
 
 
+#: the half-width (percentage points) a sweep's paired 95% intervals are sized for in the
+#: "packings needed" estimate (issue 15's target)
+TARGET_CI95_PP = 10.0
+
+
+def packings_for(se: float, n: int, half_width: float = TARGET_CI95_PP) -> int | None:
+    """Packings per condition for a paired 95% half-width of ``half_width`` percentage
+    points at the scatter measured over ``n`` packings (standard error ``se``): the sd
+    of a per-packing change, ``se sqrt(n)``, is assumed to stay, so the smallest m with
+    t(0.975, m - 1) x sd / sqrt(m) <= ``half_width``. None without a measured scatter
+    (one packing)."""
+    if not (np.isfinite(se) and n >= 2 and half_width > 0):
+        return None
+    sd = se * np.sqrt(n)
+    m = max(2, int(np.ceil((1.96 * sd / half_width) ** 2)))
+    while _factor(m) * sd / np.sqrt(m) > half_width:
+        m += 1
+    return m
+
+
 def seed_inside(seed_pct: float | None, pct: float, half: float) -> bool | None:
     """The rule of ``reproduced``: the seed's change lies inside our paired 95% interval,
     ``|seed - ours| <= ci95``; None when there is no interval (one packing) or no seed
@@ -199,6 +219,7 @@ def write_comparison(out: Path, runs: dict[int, list[tuple[dict[str, Any], Path]
     rows_csv = []
     lines = []
     printed = []
+    need: list[str] = []
     trends_json = []
     for label, a, b, seed_w, seed_c in SEED_CHANGES:
         (ow, ow_se), (orr, orr_se) = ch["wear"][(a, b)], ch["rate"][(a, b)]
@@ -220,6 +241,7 @@ def write_comparison(out: Path, runs: dict[int, list[tuple[dict[str, Any], Path]
                      f"{chains[a]:.0f} -> {chains[b]:.0f} | {_ci(oc, hc)} | "
                      f"{_fmt(seed_c)} | {yes(inside_c)} |")
         printed.append((label, _ci(ow, hw), _fmt(seed_w)))
+        need.append(f"{label} {packings_for(ow_se, n_seeds) or '-'}")
         for q, seed_pct, pct, half, inside, se in (
                 ("wear_depth", seed_w, ow, hw, inside_w, ow_se),
                 ("force_chains", seed_c, oc, hc, inside_c, oc_se)):
@@ -229,6 +251,7 @@ def write_comparison(out: Path, runs: dict[int, list[tuple[dict[str, Any], Path]
                 "change": label, "from_condition": a, "to_condition": b, "quantity": q,
                 "seed_pct": seed_pct, "ours_pct": _num(pct), "ci95_pct": _num(half),
                 "se_pct": _num(se), "reproduced": inside,
+                "packings_for_ci95_10pp": packings_for(se, n_seeds),
                 "resolved": None if not np.isfinite(half) else bool(abs(pct) > half)})
     write_csv(out / "comparison.csv",
               ["change", "from_condition", "to_condition", "seeds", "wear_depth_from_m",
@@ -355,6 +378,11 @@ def write_comparison(out: Path, runs: dict[int, list[tuple[dict[str, Any], Path]
         "our chain change (95%) | seed chain change | seed inside |",
         "|---|---|---|---|---|---|---|---|---|---|---|---|---|",
         *lines,
+        "",
+        f"Packings per condition for a +-{TARGET_CI95_PP:g} pp wear-depth interval at the "
+        "scatter measured here (the sd of the per-packing change assumed to stay; "
+        "comparison.json `packings_for_ci95_10pp`): " + "; ".join(need) + "."
+        if n_seeds > 1 else "",
         "",
         "## Trends",
         "",
