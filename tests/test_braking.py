@@ -163,6 +163,9 @@ def test_change_errors_and_verdicts() -> None:
     assert trend_verdict([(10, 2), (-10, 2)], (1, 3), "up").startswith("not resolved")
     assert trend_verdict([(-10, 2), (-10, 2)], (-20, 3), "up").startswith("not reproduced")
     assert trend_verdict([(-10, 2), (-10, 2)], (-20, 3), "down").startswith("reproduced")
+    # with 3 seeds a change must exceed t(0.975, 2) = 4.30 standard errors
+    assert step_verdict(10.0, 4.0) == "up" and step_verdict(10.0, 4.0, 3) == "not resolved"
+    assert step_verdict(10.0, 2.0, 3) == "up"
 
 
 def test_packings_for_a_target_interval() -> None:
@@ -176,9 +179,6 @@ def test_packings_for_a_target_interval() -> None:
     assert packings_for(0.1, 20) == 2  # far inside: the fewest that measure a scatter
     assert packings_for(1.0, 20) == 4  # t(0.975, 3) = 3.18: 3.18 x 4.47 / 2 = 7.1 pp
     assert packings_for(float("nan"), 1) is None
-    # with 3 seeds a change must exceed t(0.975, 2) = 4.30 standard errors
-    assert step_verdict(10.0, 4.0) == "up" and step_verdict(10.0, 4.0, 3) == "not resolved"
-    assert step_verdict(10.0, 2.0, 3) == "up"
 
 
 @pytest.fixture(scope="module")

@@ -241,17 +241,18 @@ def write_comparison(out: Path, runs: dict[int, list[tuple[dict[str, Any], Path]
                      f"{chains[a]:.0f} -> {chains[b]:.0f} | {_ci(oc, hc)} | "
                      f"{_fmt(seed_c)} | {yes(inside_c)} |")
         printed.append((label, _ci(ow, hw), _fmt(seed_w)))
-        need.append(f"{label} {packings_for(ow_se, n_seeds) or '-'}")
-        for q, seed_pct, pct, half, inside, se in (
-                ("wear_depth", seed_w, ow, hw, inside_w, ow_se),
-                ("force_chains", seed_c, oc, hc, inside_c, oc_se)):
+        need_w = packings_for(ow_se, n_seeds)
+        need.append(f"{label} {need_w or '-'}")
+        for q, seed_pct, pct, half, inside, se, need_q in (
+                ("wear_depth", seed_w, ow, hw, inside_w, ow_se, need_w),
+                ("force_chains", seed_c, oc, hc, inside_c, oc_se, packings_for(oc_se, n_seeds))):
             if seed_pct is None:
                 continue
             trends_json.append({
                 "change": label, "from_condition": a, "to_condition": b, "quantity": q,
                 "seed_pct": seed_pct, "ours_pct": _num(pct), "ci95_pct": _num(half),
                 "se_pct": _num(se), "reproduced": inside,
-                "packings_for_ci95_10pp": packings_for(se, n_seeds),
+                "packings_for_ci95_10pp": need_q,
                 "resolved": None if not np.isfinite(half) else bool(abs(pct) > half)})
     write_csv(out / "comparison.csv",
               ["change", "from_condition", "to_condition", "seeds", "wear_depth_from_m",

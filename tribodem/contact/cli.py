@@ -34,11 +34,11 @@ def validate(
     if solver not in SOLVERS:
         raise ConfigError(f"--solver = {solver!r}: allowed: {', '.join(SOLVERS)}")
     if solver == "fe":
-        from tribodem.contact.fe.ccx import resolve_ccx
+        from tribodem.contact.fe.ccx import INSTALL_COMMAND, resolve_ccx
 
         if resolve_ccx() is None:
             raise ConfigError("--solver = 'fe' needs CalculiX's ccx, which is not on PATH; "
-                              "install it with: apt-get install -y calculix-ccx")
+                              f"install it with: {INSTALL_COMMAND}")
         from tribodem.contact.fe.validate import validate_fe
         from tribodem.io.runs import announce
 

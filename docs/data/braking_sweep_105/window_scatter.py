@@ -12,12 +12,13 @@ wear came in independent events, sd/mean would fall as L^-1/2 (the last column c
 
 from __future__ import annotations
 
-import csv
 import json
 import sys
 from pathlib import Path
 
 import numpy as np
+
+from tribodem.braking.compare import _series
 
 
 def members(sweep: Path, condition: int, packings: int | None = None) -> list[np.ndarray]:
@@ -29,10 +30,8 @@ def members(sweep: Path, condition: int, packings: int | None = None) -> list[np
         s = d / "summary.json"
         if not s.exists() or json.loads(s.read_text()).get("status") != "finished":
             continue
-        with open(d / "timeseries.csv") as f:
-            rows = list(csv.DictReader(f))
-        out.append(np.array([[float(r["sliding_distance_m"]), float(r["wear_depth_mean_pad_m"])]
-                             for r in rows]))
+        ts = _series(d)  # the sweep comparison's own reader of timeseries.csv
+        out.append(np.c_[ts["sliding_distance_m"], ts["wear_depth_mean_pad_m"]])
     return out
 
 

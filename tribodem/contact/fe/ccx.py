@@ -94,10 +94,9 @@ def resolve_ccx(executable: str | None = None) -> str | None:
         executable = os.environ.get(CCX_ENV) or None
     if executable is not None:
         return shutil.which(executable)
-    for cand in (shutil.which(PARDISO_NAME), str(Path(sys.prefix) / "bin" / PARDISO_NAME)):
-        if cand and Path(cand).is_file() and os.access(cand, os.X_OK):
-            return cand
-    return shutil.which("ccx")
+    beside_python = str(Path(sys.prefix) / "bin")
+    return (shutil.which(PARDISO_NAME) or shutil.which(PARDISO_NAME, path=beside_python)
+            or shutil.which("ccx"))
 
 
 def find_ccx(executable: str | None = None) -> str:
