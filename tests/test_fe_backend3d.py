@@ -101,6 +101,37 @@ def test_morphing_worn_volume_is_exact(tmp_path: Path) -> None:
     np.testing.assert_allclose(after / before, (height - d0) / height, rtol=1e-9)
 
 
+def test_plastic_quarters_start_at_a_quarter_of_the_mindlin_slip(tmp_path: Path) -> None:
+    """Every quarter of an elastic-plastic cycle starts at a reversal, where the contact sticks
+    again: its first ccx increment slides REVERSAL_SLIDE (1/4) of the Cattaneo-Mindlin
+    gross-slip displacement, for identical bodies delta = 3 mu P (2 - nu) / (8 G a) (Johnson
+    7.42, both bodies' compliances), and may grow to the elastic decks' largest increment;
+    elastic quarters start at the largest one (deck only, no ccx run)."""
+    from tribodem.contact.fe.backend3d import REVERSAL_SLIDE
+
+    def quarters(solver: FE3DContactSolver, name: str) -> list[list[float]]:
+        deck = solver.write_deck(tmp_path / name, solver._mesh0, seat=1e-7).read_text()
+        steps = deck.split("*STEP")[3:7]  # seating, load, then the four quarters
+        return [[float(v) for v in st.split("*STATIC\n")[1].split("\n")[0].split(",")]
+                for st in steps]
+
+    body = ElasticBody()
+    delta = 3.0 * 0.6 * LOAD * (2.0 - body.poisson) / (8.0 * body.shear * A)
+    assert 3.1e-6 < delta < 3.2e-6  # the seed's case: 3.15 um
+    amplitude = 0.3e-3
+    plastic = _solver(tmp_path / "p", amplitude=amplitude, n_increments=16,
+                      material="elastic-plastic")
+    # (the solver's R comes from the surfaces' curvatures: a agrees to ~1e-6)
+    assert plastic.gross_slip_displacement == pytest.approx(delta, rel=1e-5)
+    elastic = _solver(tmp_path / "e", amplitude=amplitude, n_increments=16)
+    largest = 4.0 / (16 * plastic.cycle_refine)
+    for first, period, smallest, most in quarters(plastic, "p.inp"):
+        assert first * amplitude == pytest.approx(REVERSAL_SLIDE * delta, rel=1e-5)
+        assert (period, most) == (1.0, largest) and smallest <= first
+    for first, period, _, most in quarters(elastic, "e.inp"):
+        assert first == most == 4.0 / 16 and period == 1.0
+
+
 def test_fe3d_refuses_other_geometries(tmp_path: Path) -> None:
     from tribodem.contact.geometry import cylinder, flat
 

@@ -148,6 +148,20 @@ def test_critical_plane_uniaxial():
     assert plane_normals(5.0).shape == (36 * 36, 3)
 
 
+def test_critical_plane_alternating_shear():
+    # tau_xy = +-T: the critical planes are at 45 deg (on the 5 deg grid), sigma_n = T, the
+    # trace is zero, so eps_n = (1 + nu) sigma_n / E swings by 2 (1 + nu) T / E:
+    # SWT = T (1 + nu) T / E; a mean normal stress S along x on top shifts sigma_max on the
+    # 45 deg plane by S / 2 and not the strain range: SWT = (T + S / 2) (1 + nu) T / E
+    t, s = 300e6, 200e6
+    hist = np.zeros((2, 2, 6))
+    hist[0, :, 5], hist[1, :, 5] = t, -t
+    hist[:, 1, 0] = s
+    swt = critical_plane_swt(hist, E, NU, plane_normals(5.0))
+    assert swt[0] == pytest.approx((1 + NU) * t * t / E, rel=1e-12)
+    assert swt[1] >= (t + 0.5 * s) * (1 + NU) * t / E * (1 - 1e-12)
+
+
 class _FakeCyclic:
     """Uniform uniaxial stress alternating +S / -S from one sampled increment to the next."""
 

@@ -31,6 +31,7 @@ from dataclasses import dataclass
 from typing import Any, ClassVar
 
 import numpy as np
+from numba import njit, prange
 from numpy.typing import NDArray
 
 from tribodem.contact.base import FirstBodySolver, IncrementResult, SubsurfaceStress, require
@@ -652,27 +653,48 @@ def plane_normals(step_deg: float = 5.0) -> NDArray[np.float64]:
 
 
 def critical_plane_swt(history: NDArray[np.float64], young: float, poisson: float,
-                       normals: NDArray[np.float64], chunk: int = 2048) -> NDArray[np.float64]:
+                       normals: NDArray[np.float64]) -> NDArray[np.float64]:
     """Maximum over candidate planes of SWT = sigma_max Delta eps / 2 (eqs 6.3, 6.5-6.6), Pa.
 
     ``history`` [T, P, 6]: Voigt stresses (xx, yy, zz, yz, xz, xy, Pa) of P points at T
     instants. On each plane sigma_n(t) = n.sigma.n (eq 6.5) and the elastic normal strain
     eps_n = ((1 + nu) sigma_n - nu tr sigma) / E (eq 6.6 with Hooke's law); sigma_max =
     max_t sigma_n, Delta eps = max_t eps_n - min_t eps_n; planes with sigma_max <= 0 give 0.
+    A numba kernel over the points (threads), the planes in SIMD lanes.
     """
     h = np.asarray(history, dtype=float)
     nx, ny, nzv = normals[:, 0], normals[:, 1], normals[:, 2]
-    proj = np.stack([nx * nx, ny * ny, nzv * nzv, 2 * ny * nzv, 2 * nx * nzv, 2 * nx * ny])
+    proj = np.ascontiguousarray(
+        np.stack([nx * nx, ny * ny, nzv * nzv, 2 * ny * nzv, 2 * nx * nzv, 2 * nx * ny]))
     out = np.zeros(h.shape[1])
-    for i in range(0, h.shape[1], chunk):
-        c = h[:, i : i + chunk]
-        sn = c @ proj  # [T, C, planes]
-        tr = c[..., :3].sum(-1)[..., None]
-        en = ((1 + poisson) * sn - poisson * tr) / young
-        smax = sn.max(0)
-        de = en.max(0) - en.min(0)
-        out[i : i + chunk] = np.where(smax > 0, 0.5 * smax * de, 0.0).max(-1)
+    _critical_plane_swt(h, proj, float(young), float(poisson), out)
     return out
+
+
+@njit(parallel=True, cache=True)
+def _critical_plane_swt(h, proj, young, poisson, out):  # pragma: no cover - numba
+    """``critical_plane_swt`` on ``h`` [T, P, 6] and ``proj`` [6, planes] into ``out`` [P]."""
+    npl = proj.shape[1]
+    for p in prange(h.shape[1]):
+        smax = np.full(npl, -np.inf)
+        emax = np.full(npl, -np.inf)
+        emin = np.full(npl, np.inf)
+        for t in range(h.shape[0]):
+            s0, s1, s2, s3, s4, s5 = h[t, p, 0], h[t, p, 1], h[t, p, 2], h[t, p, 3], \
+                h[t, p, 4], h[t, p, 5]
+            tr = s0 + s1 + s2
+            for q in range(npl):
+                sn = (s0 * proj[0, q] + s1 * proj[1, q] + s2 * proj[2, q] + s3 * proj[3, q]
+                      + s4 * proj[4, q] + s5 * proj[5, q])
+                en = ((1.0 + poisson) * sn - poisson * tr) / young
+                smax[q] = max(smax[q], sn)
+                emax[q] = max(emax[q], en)
+                emin[q] = min(emin[q], en)
+        best = 0.0
+        for q in range(npl):
+            if smax[q] > 0.0:
+                best = max(best, 0.5 * smax[q] * (emax[q] - emin[q]))
+        out[p] = best
 
 
 class SWTCriterion(ThresholdCriterion):

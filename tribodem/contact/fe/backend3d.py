@@ -115,6 +115,12 @@ FRETTING3D_SIZE_FACTOR = 8.0
 FRETTING3D_GROWTH = 1.4
 #: contact penalty of the 3D backend: normal stiffness = factor x E_min / h, Pa/m
 PENALTY_FACTOR = 10.0
+#: elastic-plastic cycles: the first ccx increment of each quarter (each starts at a
+#: reversal, where the whole contact sticks again) slides this fraction of the Mindlin
+#: gross-slip displacement (ccx then grows it). Started at the largest increment, the
+#: seed's first reversal needed 5 cut-backs, ccx's limit (two PARDISO threads: 6, "too
+#: many cutbacks"); from 1/4 of it, 1-2 (docs/fe3d.md, measured)
+REVERSAL_SLIDE = 0.25
 
 #: modes of :class:`FE3DContactSolver` (``chained`` is the 2D backend's only)
 MODES = ("fresh", "primed")
@@ -556,6 +562,16 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         return float(gap.min()) + 0.05 * a * a / self.radius
 
     @property
+    def gross_slip_displacement(self) -> float:
+        """Cattaneo-Mindlin relative tangential displacement at the onset of gross slip of
+        the circular contact, m: delta = 3 mu P / (16 a) ((2 - nu1) / G1 + (2 - nu2) / G2)
+        (Johnson 1985, eq. 7.42 with both bodies' compliances; a the Hertz radius). A reversal
+        of the stroke takes 2 delta to slide again."""
+        body = (self.upper_material, self.lower_material)
+        compliance = sum((2.0 - b.poisson) / b.shear for b in body)
+        return 3.0 * self.friction * self.load / (16.0 * self.hertz[1]) * compliance
+
+    @property
     def plastic_depth(self) -> float:
         """Depth of the grid of :meth:`plastic_steps`, m: 1.5 Hertz radii (first yield of a
         point contact at 0.48 a, shallower with friction), at most the printed column depth."""
@@ -644,11 +660,14 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         out.write(debris)
         out.write(outputs("TLOAD") + "*END STEP\n")
         dt = 4.0 / (self.n_increments * refine * self.cycle_refine)
+        dt0 = dt
+        if self.plastic:  # each quarter starts at a reversal: first slide REVERSAL_SLIDE delta
+            dt0 = min(dt, REVERSAL_SLIDE * self.gross_slip_displacement / self.amplitude)
         targets = (self.amplitude, 0.0, -self.amplitude, 0.0)
         if self._primed():  # the previous cycle's second half: a continuous test's history
             targets = (-self.amplitude, 0.0) + targets
         for k, target in enumerate(targets):
-            out.write(f"*STEP, INC=10000\n*STATIC\n{dt}, 1., {dt * 1e-4}, {dt}\n")
+            out.write(f"*STEP, INC=10000\n*STATIC\n{dt0}, 1., {min(dt0, dt * 1e-4)}, {dt}\n")
             if k == 0:
                 out.write(friction(s.mu, s.stick_factor))
             out.write(f"*BOUNDARY\n{ref}, 1, 1, {_fmt(target)}\n")
