@@ -660,7 +660,7 @@ def critical_plane_swt(history: NDArray[np.float64], young: float, poisson: floa
     instants. On each plane sigma_n(t) = n.sigma.n (eq 6.5) and the elastic normal strain
     eps_n = ((1 + nu) sigma_n - nu tr sigma) / E (eq 6.6 with Hooke's law); sigma_max =
     max_t sigma_n, Delta eps = max_t eps_n - min_t eps_n; planes with sigma_max <= 0 give 0.
-    A numba kernel over the points (threads), the planes in SIMD lanes.
+    A numba kernel: the points in threads, the planes in the innermost loop.
     """
     h = np.asarray(history, dtype=float)
     nx, ny, nzv = normals[:, 0], normals[:, 1], normals[:, 2]

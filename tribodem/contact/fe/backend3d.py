@@ -119,7 +119,7 @@ PENALTY_FACTOR = 10.0
 #: reversal, where the whole contact sticks again) slides this fraction of the Mindlin
 #: gross-slip displacement (ccx then grows it). Started at the largest increment, the
 #: seed's first reversal needed 5 cut-backs, ccx's limit (two PARDISO threads: 6, "too
-#: many cutbacks"); from 1/4 of it, 1-2 (docs/fe3d.md, measured)
+#: many cutbacks"); from 1/4 of it, 1-3 (docs/fe3d.md, measured)
 REVERSAL_SLIDE = 0.25
 
 #: modes of :class:`FE3DContactSolver` (``chained`` is the 2D backend's only)
