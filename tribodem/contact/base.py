@@ -73,6 +73,16 @@ def contact_modulus(a: ElasticBody, b: ElasticBody) -> float:
     return 1.0 / ((1 - a.poisson**2) / a.young + (1 - b.poisson**2) / b.young)
 
 
+def mindlin_kappa(a: ElasticBody, b: ElasticBody) -> float:
+    """Mindlin's tangential / normal compliance ratio kappa = sum (2 - nu_i)/G_i /
+    (2 sum (1 - nu_i)/G_i) (1.214 for nu = 0.3): gross slip of a Hertz contact after a
+    relative tangential displacement delta* = mu kappa d, d the normal approach (Johnson
+    1985, eqs 7.42-7.43)."""
+    return ((2 - a.poisson) / a.shear + (2 - b.poisson) / b.shear) / (
+        2 * ((1 - a.poisson) / a.shear + (1 - b.poisson) / b.shear)
+    )
+
+
 def dundurs_beta(a: ElasticBody, b: ElasticBody) -> float:
     """Dundurs' second constant (0 for elastically similar bodies: no normal-shear coupling)."""
     k1 = (1 - 2 * a.poisson) / a.shear - (1 - 2 * b.poisson) / b.shear

@@ -56,6 +56,7 @@ from tribodem.contact.base import (
     checked_debris_pressure,
     contact_modulus,
     dundurs_beta,
+    mindlin_kappa,
 )
 from tribodem.contact.geometry import HertzSphere, Recession, crossed_cylinders, line_window
 
@@ -209,11 +210,8 @@ class HalfSpaceSolver(FirstBodySolver):
         self._model.E = 1.0
         self._model.nu = 0.0
         self._model_star = tm.ModelFactory.createModel(self._model)
-        um, lm = self.upper_material, self.lower_material
         #: Mindlin tangential / normal compliance ratio kappa (1.214 for nu = 0.3)
-        self.kappa = ((2 - um.poisson) / um.shear + (2 - lm.poisson) / lm.shear) / (
-            2 * ((1 - um.poisson) / um.shear + (1 - lm.poisson) / lm.shear)
-        )
+        self.kappa = mindlin_kappa(self.upper_material, self.lower_material)
         c = np.arange(-self.n + 1, self.n) * self.dx
         xe, ye = np.meshgrid(c, c, indexing="ij")
         self._kernel = _cell_integral(xe, ye, self.dx)  # int over a cell of 1/r, m

@@ -71,6 +71,7 @@ from tribodem.contact.base import (
     checked_debris_pressure,
     contact_modulus,
     cycle_offsets,
+    mindlin_kappa,
 )
 from tribodem.contact.elastoplastic import PlasticStep
 from tribodem.contact.fe.backend import (
@@ -564,12 +565,13 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
     @property
     def gross_slip_displacement(self) -> float:
         """Cattaneo-Mindlin relative tangential displacement at the onset of gross slip of
-        the circular contact, m: delta = 3 mu P / (16 a) ((2 - nu1) / G1 + (2 - nu2) / G2)
-        (Johnson 1985, eq. 7.42 with both bodies' compliances; a the Hertz radius). A reversal
-        of the stroke takes 2 delta to slide again."""
-        body = (self.upper_material, self.lower_material)
-        compliance = sum((2.0 - b.poisson) / b.shear for b in body)
-        return 3.0 * self.friction * self.load / (16.0 * self.hertz[1]) * compliance
+        the circular contact, m: delta* = mu kappa a^2 / R (``mindlin_kappa``; = 3 mu P /
+        (16 a) ((2 - nu1) / G1 + (2 - nu2) / G2), Johnson 1985 eq. 7.42 with both bodies'
+        compliances; a the Hertz radius). A reversal of the stroke takes 2 delta* to slide
+        again."""
+        a = self.hertz[1]
+        kappa = mindlin_kappa(self.upper_material, self.lower_material)
+        return self.friction * kappa * a * a / self.radius
 
     @property
     def plastic_depth(self) -> float:
