@@ -21,12 +21,12 @@ CONFIG = """[case]
 particles = 300
 seed = 3
 [run]
-steps = 6000
+steps = 24000
 threads = 1
 [output]
-scalars_every = 25
-vtk_every = 500
-checkpoint_every = 500
+scalars_every = 100
+vtk_every = 2000
+checkpoint_every = 2000
 """
 
 #: Outputs compared byte for byte (summary.json: everything but the wall-clock time).
@@ -57,7 +57,11 @@ def _same(a: Path, b: Path) -> None:
 
 def _start_and_stop(cfg: Path, out: Path, sig: int, rng: random.Random
                     ) -> subprocess.CompletedProcess:
-    """Start a run, wait for its first checkpoint, stop it with ``sig`` a little later."""
+    """Start a run, wait for its first checkpoint, stop it with ``sig`` a little later.
+
+    The run's 22,000 steps after its first checkpoint take ~1.2 s on one core (2026), the
+    wait at most 0.3 s: the signal lands mid-run (checked: no summary yet).
+    """
     p = subprocess.Popen([tribodem_exe(), "dem", "run", "--config", str(cfg), "--out",
                           str(out), "--no-progress"], stdout=subprocess.PIPE,
                          stderr=subprocess.PIPE, text=True, preexec_fn=default_sigint)
@@ -67,8 +71,8 @@ def _start_and_stop(cfg: Path, out: Path, sig: int, rng: random.Random
         assert time.monotonic() - t0 < 300
         time.sleep(0.02)
     time.sleep(rng.uniform(0.0, 0.3))
-    if p.poll() is None:
-        p.send_signal(sig)
+    assert p.poll() is None and not (out / "summary.json").exists(), "ended before the stop"
+    p.send_signal(sig)
     o, e = p.communicate(timeout=120)
     return subprocess.CompletedProcess(p.args, p.returncode, o, e)
 
@@ -91,9 +95,34 @@ def test_dem_run_stopped_then_resumed_equals_uninterrupted(tmp_path: Path, sig: 
     _same(ref, out)
 
 
+def test_ctrl_c_as_the_command_ends_exits_130_with_the_message_or_0(tmp_path: Path) -> None:
+    """Ctrl-C after the results are written, while the process shuts down: exit 130 with
+    the message (or 0 if it came too late to matter), never death by SIGINT (exit -2, no
+    message: what Python's shutdown, which restores the default action, gave before)."""
+    cfg = tmp_path / "c.toml"
+    cfg.write_text(CONFIG.replace("steps = 24000", "steps = 200"))
+    codes = []
+    for i in range(6):
+        out = tmp_path / f"o{i}"
+        p = subprocess.Popen([tribodem_exe(), "dem", "run", "--config", str(cfg), "--out",
+                              str(out), "--no-progress"], stdout=subprocess.PIPE,
+                             stderr=subprocess.PIPE, text=True, preexec_fn=default_sigint)
+        t0 = time.monotonic()
+        while not (out / "summary.json").exists() and p.poll() is None:
+            assert time.monotonic() - t0 < 300
+            time.sleep(0.0005)
+        p.send_signal(signal.SIGINT)
+        _, e = p.communicate(timeout=120)
+        codes.append(p.returncode)
+        assert p.returncode in (0, 130) and "Traceback" not in e, (p.returncode, e)
+        if p.returncode == 130:
+            assert "interrupted" in e and str(out) in e and "--resume" in e, e
+    print(codes)
+
+
 def test_dem_resume_refuses_a_changed_case_before_touching_outputs(tmp_path: Path) -> None:
     cfg = tmp_path / "c.toml"
-    cfg.write_text(CONFIG.replace("steps = 6000", "steps = 250"))
+    cfg.write_text(CONFIG.replace("steps = 24000", "steps = 250"))
     out = tmp_path / "o"
     assert run_tribodem("dem", "run", "--config", str(cfg), "--out", str(out),
                         "--no-progress").returncode == 0
@@ -133,11 +162,11 @@ def test_step0_contacts_are_the_touching_pairs(tmp_path: Path) -> None:
     touching = int(np.count_nonzero(pdist(case.positions) <
                                     (r[:, None] + r[None, :])[np.triu_indices(len(r), 1)]))
     cfg = tmp_path / "c.toml"
-    cfg.write_text(CONFIG.replace("steps = 6000", "steps = 25"))
+    cfg.write_text(CONFIG.replace("steps = 24000", "steps = 25"))
     out = tmp_path / "o"
     assert run_tribodem("dem", "run", "--config", str(cfg), "--out", str(out),
                         "--no-progress").returncode == 0
-    ts = np.genfromtxt(out / "timeseries.csv", delimiter=",", names=True)
+    ts = np.atleast_1d(np.genfromtxt(out / "timeseries.csv", delimiter=",", names=True))
     assert ts["step"][0] == 0 and ts["contacts"][0] == touching < 50
     chains = meshio.read(out / "vtk" / "chains_000000000.vtu")
     assert sum(len(c.data) for c in chains.cells) == touching
@@ -146,7 +175,7 @@ def test_step0_contacts_are_the_touching_pairs(tmp_path: Path) -> None:
 def test_outputs_get_the_umask_mode(tmp_path: Path) -> None:
     out = tmp_path / "o"
     cfg = tmp_path / "c.toml"
-    cfg.write_text(CONFIG.replace("steps = 6000", "steps = 25"))
+    cfg.write_text(CONFIG.replace("steps = 24000", "steps = 25"))
     r = run_tribodem("dem", "run", "--config", str(cfg), "--out", str(out), "--no-progress",
                      env={**os.environ}, preexec_fn=lambda: os.umask(0o022))
     assert r.returncode == 0, r.stderr
