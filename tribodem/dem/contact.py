@@ -292,6 +292,11 @@ def _pair_consts(prop, ri, rj, mi, mj, ii, ij, ei, ej, dim, thickness):
 #: columns of the per-pair constants (``pair_constants``)
 C_LINK, C_RSTAR, C_MSTAR, C_ISTAR = range(4)
 N_PCONST = 4
+#: a listed pair with |d|^2 > (r_i + r_j)^2 x APART is apart for certain (the margin is far
+#: above the rounding of the squares, so no pair the exact test finds touching is skipped):
+#: if it was apart at the last evaluation too, the pair passes skip it without the root or
+#: any store (``pinfo[p, 0]`` keeps the gap, <= 0, of the evaluation that found it apart)
+APART = 1.0 + 1e-12
 
 
 @njit(cache=True)
@@ -354,11 +359,13 @@ def pair_forces_sum(pos, vel, omega, radius, mass, inertia, mat, pair_i, pair_j,
     LIGGGHTS): ``force``/``torque`` (N, N m) are zeroed, then each touching pair p adds
     ``-fpair[p]`` / its torque on i to i and ``+fpair[p]`` / its torque on j to j in
     increasing p. ``fpair[p]``: force on j (N); ``pinfo[p]`` = (overlap m, normal force N,
-    energy J, kn N/m). A pair found apart is cleared only if it was in contact
-    (``pinfo[p, 0] > 0``) at the previous evaluation; ``tpair_*`` are not stored (only
-    cleared when a contact ends). Run it through its serial build only (the loop writes
-    shared rows); threaded runs use ``pair_forces_cross`` + ``pair_forces_blocked``,
-    which give each particle its pairs in the same increasing p: the same bits.
+    energy J, kn N/m); for a pair apart ``pinfo[p, 0]`` is <= 0, the gap (-) found when it
+    was first found apart (not updated while it stays apart: see ``APART``). A pair found
+    apart is cleared only if it was in contact (``pinfo[p, 0] > 0``) at the previous
+    evaluation; ``tpair_*`` are not stored (only cleared when a contact ends). Run it
+    through its serial build only (the loop writes shared rows); threaded runs use
+    ``pair_forces_cross`` + ``pair_forces_blocked``, which give each particle its pairs in
+    the same increasing p: the same bits.
 
     ``pconst``: the pairs' constants (``pair_constants``, valid while radii, masses and
     materials are unchanged) or ``None`` (computed per contact): the same values either
@@ -380,6 +387,8 @@ def pair_forces_sum(pos, vel, omega, radius, mass, inertia, mat, pair_i, pair_j,
         rj = radius[j]
         dist2 = d0 * d0 + d1 * d1 + d2 * d2
         rs = ri + rj
+        if dist2 > rs * rs * APART and not pinfo[p, 0] > 0.0:
+            continue  # apart now and at the last evaluation: nothing to do
         f0 = f1 = f2 = a0 = a1 = a2 = b0 = b1 = b2 = fn = energy = kn = 0.0
         dist = np.sqrt(dist2)
         delta = rs - dist
@@ -509,8 +518,11 @@ def pair_forces_cross(pos, vel, omega, radius, mass, inertia, mat, pair_i, pair_
         ri = radius[i]
         rj = radius[j]
         dist2 = d0 * d0 + d1 * d1 + d2 * d2
+        rs = ri + rj
+        if dist2 > rs * rs * APART and not pinfo[p, 0] > 0.0:
+            continue  # apart now and at the last evaluation
         dist = np.sqrt(dist2)
-        delta = ri + rj - dist
+        delta = rs - dist
         if not (delta > 0.0 and dist2 > 0.0):  # apart: clear a contact just ended
             if pinfo[p, 0] > 0.0:
                 for k in range(3):
@@ -608,8 +620,11 @@ def pair_forces_blocked(pos, vel, omega, radius, mass, inertia, mat, start, pair
                 ri = radius[i]
                 rj = radius[j]
                 dist2 = d0 * d0 + d1 * d1 + d2 * d2
+                rs = ri + rj
+                if dist2 > rs * rs * APART and not pinfo[p, 0] > 0.0:
+                    continue  # apart now and at the last evaluation
                 dist = np.sqrt(dist2)
-                delta = ri + rj - dist
+                delta = rs - dist
                 if not (delta > 0.0 and dist2 > 0.0):  # apart: clear a contact just ended
                     if pinfo[p, 0] > 0.0:
                         for k in range(3):
@@ -751,8 +766,11 @@ def pair_forces_sum_2d(pos, vel, omega, radius, mass, inertia, mat, pair_i, pair
         ri = radius[i]
         rj = radius[j]
         dist2 = d0 * d0 + d1 * d1
+        rs = ri + rj
+        if dist2 > rs * rs * APART and not pinfo[p, 0] > 0.0:
+            continue  # apart now and at the last evaluation: nothing to do
         dist = np.sqrt(dist2)
-        delta = ri + rj - dist
+        delta = rs - dist
         if not (delta > 0.0 and dist2 > 0.0):  # apart: clear a contact that just ended
             if pinfo[p, 0] > 0.0:
                 for k in range(3):
