@@ -449,17 +449,6 @@ def _bond_lanes(x, y, m, dt):  # pragma: no cover - numba
 _bonds_general = bond_forces.serial
 
 
-@njit(cache=True, inline="always")
-def _put(force, torque, i, f0, f1, f2, t0, t1, t2):  # pragma: no cover - numba
-    """Write particle i's force (N) and torque (N m) rows."""
-    force[i, 0] = f0
-    force[i, 1] = f1
-    force[i, 2] = f2
-    torque[i, 0] = t0
-    torque[i, 1] = t1
-    torque[i, 2] = t2
-
-
 @kernel
 def bond_forces_3d(pos, vel, omega, radius, bi, bj, rb, area, ib, jb, kn, ks, tens, coh,
                    tanphi, fn, fs, mb, mt, nrm, mode, newly, brk, fbond, tbi, tbj, dt, length,
@@ -520,20 +509,12 @@ def bond_forces_3d(pos, vel, omega, radius, bi, bj, rb, area, ib, jb, kn, ks, te
                 for k in range(N_K):
                     x[(X_K + k) * RS + q] = kc[b, k]
             _bond_lanes(x, y, m, dt)
-            # summed: particle i's force and torque stay in registers over its run of bonds
-            # (ci; written back before any other access to its rows: same operations, same
-            # order, same bits)
-            ci = -1
-            g0 = g1 = g2 = u0 = u1 = u2 = 0.0
             for q in range(m):
                 b = b0 + q
                 if mode[b] != INTACT:
                     continue
                 flag = y[Y_FLAG * RS + q]
                 if flag == 2.0:  # a large spin angle: libm's cos and sin
-                    if ci >= 0:
-                        _put(ext_force, ext_torque, ci, g0, g1, g2, u0, u1, u2)
-                        ci = -1
                     nnew += _bonds_general(
                         pos, vel, omega, radius, bi[b:b + 1], bj[b:b + 1], rb[b:b + 1],
                         area[b:b + 1], ib[b:b + 1], jb[b:b + 1], kn[b:b + 1], ks[b:b + 1],
@@ -606,22 +587,12 @@ def bond_forces_3d(pos, vel, omega, radius, bi, bj, rb, area, ib, jb, kn, ks, te
                 f1 = y[Y_F1 * RS + q]
                 f2 = y[Y_F2 * RS + q]
                 if summed:
-                    if i != ci or j == ci:
-                        if ci >= 0:
-                            _put(ext_force, ext_torque, ci, g0, g1, g2, u0, u1, u2)
-                        ci = i
-                        g0 = ext_force[i, 0]
-                        g1 = ext_force[i, 1]
-                        g2 = ext_force[i, 2]
-                        u0 = ext_torque[i, 0]
-                        u1 = ext_torque[i, 1]
-                        u2 = ext_torque[i, 2]
-                    g0 -= f0
-                    g1 -= f1
-                    g2 -= f2
-                    u0 += y[Y_TI0 * RS + q]
-                    u1 += y[Y_TI1 * RS + q]
-                    u2 += y[Y_TI2 * RS + q]
+                    ext_force[i, 0] -= f0
+                    ext_force[i, 1] -= f1
+                    ext_force[i, 2] -= f2
+                    ext_torque[i, 0] += y[Y_TI0 * RS + q]
+                    ext_torque[i, 1] += y[Y_TI1 * RS + q]
+                    ext_torque[i, 2] += y[Y_TI2 * RS + q]
                     ext_force[j, 0] += f0
                     ext_force[j, 1] += f1
                     ext_force[j, 2] += f2
@@ -638,8 +609,6 @@ def bond_forces_3d(pos, vel, omega, radius, bi, bj, rb, area, ib, jb, kn, ks, te
                 tbj[b, 0] = y[Y_TJ0 * RS + q]
                 tbj[b, 1] = y[Y_TJ1 * RS + q]
                 tbj[b, 2] = y[Y_TJ2 * RS + q]
-            if ci >= 0:
-                _put(ext_force, ext_torque, ci, g0, g1, g2, u0, u1, u2)
     return nnew
 
 
