@@ -7,8 +7,9 @@ loaded), and in the few instructions of the error handling itself. Here one hand
 installed before anything heavy is imported; it raises ``KeyboardInterrupt`` once, while
 the command works (``tribodem.cli.main`` turns that into the message and exit 130), and
 any later Ctrl-C prints the same message and ends the process with 130 at once. After the
-work the exit handlers run, the streams are flushed, and the process ends without the
-module teardown. Only the standard library is imported here.
+work the other threads are waited for and the exit handlers run as in Python's own
+shutdown, the streams are flushed, and the process ends without the module teardown.
+Only the standard library is imported here.
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ import atexit
 import os
 import signal
 import sys
+import threading
 
 _working = True
 
@@ -65,6 +67,10 @@ def entry() -> None:
     if isinstance(code, str):
         sys.stderr.write(code + "\n")
         code = 1
+    # what Python's shutdown does first: wait for the threads that are not daemons
+    for t in threading.enumerate():
+        if t is not threading.main_thread() and not t.daemon:
+            t.join()
     atexit._run_exitfuncs()
     sys.stdout.flush()
     sys.stderr.flush()

@@ -171,7 +171,7 @@ def compact_periodic(spec: MaterialSpec, width: float, height: float, seed: int,
     walls set the vertical stress only, and across a periodic cell wider than it is high
     the horizontal packing closes in a time that grows with the width (an 864-um cell at
     the nominal steps: 8-25 % of its particles without a neighbour within the bond gap,
-    and a wall stress that fell from ~1 MPa to 10-26 kPa when relaxed further, i.e. the
+    and a wall stress that fell from ~1 MPa to 7-26 kPa when relaxed further, i.e. the
     bisection had read transients). Stats: ``loose_fraction`` (particles without a
     neighbour within ``gap``, m; default the spec's bond gap) and ``relax_scale``.
     Returns (pos, radii, stats)."""
