@@ -150,7 +150,7 @@ def test_a_wide_cell_is_compacted_as_densely_as_the_default_one() -> None:
     3,401 particles dropped as unbonded)."""
     disc, _ = materials("calibrated")
     w = 864e-6
-    pos, radii, stats = compact_periodic(disc, w, 196e-6, seed=1)
+    _, _, stats = compact_periodic(disc, w, 196e-6, seed=1)
     assert stats["relax_scale"] == 4.0
     assert stats["loose_fraction"] <= LOOSE_MAX, stats
 

@@ -23,7 +23,8 @@ import threading
 _working = True
 
 
-def _message() -> str:
+def interrupted_message() -> str:
+    """The Ctrl-C message: where the outputs and the last checkpoint are (``runs.where``)."""
     runs = sys.modules.get("tribodem.io.runs")
     where = runs.where() if runs is not None else ""
     return "\ninterrupted (Ctrl-C)" + (f": {where}" if where else "")
@@ -36,7 +37,7 @@ def _on_sigint(signum: int, frame: object) -> None:
         raise KeyboardInterrupt
     try:  # after it, or after the work: report and leave at once
         sys.stdout.flush()
-        sys.stderr.write(_message() + "\n")
+        sys.stderr.write(interrupted_message() + "\n")
         sys.stderr.flush()
     finally:
         os._exit(130)
@@ -60,7 +61,7 @@ def entry() -> None:
         code = e.code
     except KeyboardInterrupt:  # raised outside main's own handling (import, error paths)
         _working = False
-        sys.stderr.write(_message() + "\n")
+        sys.stderr.write(interrupted_message() + "\n")
         code = 130
     finally:
         _working = False

@@ -90,11 +90,11 @@ def main() -> None:
     kept; 130 Ctrl-C, after saying where the outputs and the last checkpoint are. None of
     these prints a traceback.
     """
+    from tribodem._entry import interrupted_message
     from tribodem.io import runs
 
     def interrupted() -> None:
-        where = runs.where()
-        typer.echo("\ninterrupted (Ctrl-C)" + (f": {where}" if where else ""), err=True)
+        typer.echo(interrupted_message(), err=True)
         sys.exit(130)
 
     try:
