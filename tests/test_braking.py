@@ -377,6 +377,11 @@ def test_until_steady_with_a_load_ramp_resumes_bitwise(tmp_path: Path,
     full = run_braking(_tiny(change), tmp_path / "a")
     assert full["simulated_sliding_distance_m"] == pytest.approx(47.12 * 0.8e-6, rel=0.02)
     assert full["steady_reached"] is False and 0 <= full["contact_fraction"] <= 1
+    # the assumptions say what that outcome means for the rates
+    notes = full["assumptions"]
+    assert any(a.startswith("steady-state rule not passed") for a in notes)
+    assert any(a.startswith("interface in contact") for a in notes) == (
+        full["contact_fraction"] < run_mod.CLOSED_CONTACT)
     for k in ("wear_rate_steady_m_per_m", "run_in_distance_m", "run_in_depth_m",
               "interface_load_ratio_mean", "sliding_distance_cap_m"):
         assert k in full

@@ -247,6 +247,10 @@ class _Loop:
 
 #: steps between two looks at the disc-pad contacts (``contact_fraction``)
 CONTACT_EVERY = 16
+#: ``contact_fraction`` from which the interface counts as closed (issue 15: a pad under
+#: hydraulic pressure is in contact >= 90 % of the time); below it the summary's
+#: assumptions say that the rates average contact episodes
+CLOSED_CONTACT = 0.9
 
 
 def interface_load(iface: Interface) -> float:
@@ -700,6 +704,7 @@ def run_braking(setup: RunSetup, out: Path | None = None, *, resume: bool = Fals
         "wall_time_s": wall_before["total"] + time.perf_counter() - t_wall,
         "assumptions": _assumptions(setup),
     }
+    summary["assumptions"] += _outcome_notes(summary)
     if out is not None:
         out.mkdir(parents=True, exist_ok=True)
         write_csv(out / "timeseries.csv", list(rows[0]), [list(r.values()) for r in rows])
@@ -731,6 +736,27 @@ def _frame(iface: Interface, ref: Reference, slid: float) -> dict[str, np.ndarra
             "disp": body_displacement(iface, ref, slid), "group": p.group.copy(),
             "detached": ~matrix, "chain_i": ch["i"], "chain_j": ch["j"],
             "chain_f": ch["force"], "slid": np.array(slid)}
+
+
+def _outcome_notes(summary: dict[str, Any]) -> list[str]:
+    """What the run's own outcome means for its rates: an interface open for long spells
+    (``contact_fraction`` < ``CLOSED_CONTACT``), a steady-state rule that did not pass."""
+    notes = []
+    cf = summary["contact_fraction"]
+    if cf < CLOSED_CONTACT:
+        notes.append(
+            f"interface in contact {100 * cf:.0f} % of the sliding time (closed: >= "
+            f"{100 * CLOSED_CONTACT:.0f} %): the pad flies between asperity impacts (the "
+            "cell is narrower than the pad's load-sharing length), so the wear rates average "
+            "contact episodes, not a closed sliding contact; wider cells ([geometry] "
+            "width_m) close it (docs/braking.md)")
+    if not summary["steady_reached"]:
+        notes.append(
+            "steady-state rule not passed within the distance slid: "
+            "wear_rate_steady_m_per_m is the slope over the last two thirds of a rate still "
+            "changing (compare wear_rate_middle_third_m_per_m and "
+            "wear_rate_last_third_m_per_m)")
+    return notes
 
 
 def _assumptions(setup: RunSetup) -> list[str]:
