@@ -176,6 +176,27 @@ def test_which_ccx_runs(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None
     assert resolve_ccx() is None
 
 
+def test_ccx_environment(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """run_ccx hands ccx its thread counts and glibc's malloc tunables (kept if the caller
+    set GLIBC_TUNABLES), through a stand-in ccx that prints its environment."""
+    from tribodem.contact.fe.ccx import MALLOC_TUNABLES
+
+    fake = tmp_path / "env_ccx"
+    fake.write_text("#!/bin/sh\nenv\necho 'Job finished'\n")
+    fake.chmod(0o755)
+    deck = tmp_path / "job.inp"
+    deck.write_text("*HEADING\n")
+    monkeypatch.delenv("GLIBC_TUNABLES", raising=False)
+    run_ccx(deck, threads=2, timeout=60, executable=str(fake))
+    env = dict(ln.split("=", 1) for ln in (tmp_path / "job.log").read_text().splitlines()
+               if "=" in ln)
+    assert env["GLIBC_TUNABLES"] == MALLOC_TUNABLES
+    assert env["OMP_NUM_THREADS"] == env["MKL_NUM_THREADS"] == "2"
+    monkeypatch.setenv("GLIBC_TUNABLES", "glibc.malloc.hugetlb=1")
+    run_ccx(deck, threads=1, timeout=60, executable=str(fake))
+    assert "GLIBC_TUNABLES=glibc.malloc.hugetlb=1" in (tmp_path / "job.log").read_text()
+
+
 # --- with ccx ---------------------------------------------------------------------------------
 
 @pytest.fixture(scope="module")
