@@ -68,6 +68,31 @@ def test_table4_conversions() -> None:
         load_to_pressure(-1.0)
 
 
+def test_rough_profile_wide_cell_keeps_the_asperities() -> None:
+    """A cell 16x the default width with modes k = 16..64 has the default cell's
+    wavelengths (216..54 um) and rms slope within a factor 0.4-1.2 of it (the peak, not
+    each asperity, is scaled to the amplitude); with k = 1..64 its slopes are < 0.35 x
+    (the amplitude goes to the 3.5 mm waves). max |h| = amplitude in every case."""
+    w, amp = 216e-6, 8e-6
+
+    def rms_slope(width: float, prof: tuple[np.ndarray, ...]) -> float:
+        x = np.linspace(0.0, width, 20001)
+        h = profile_height(x, width, prof)
+        assert np.abs(h).max() == pytest.approx(amp, rel=0.01)
+        return float(np.sqrt(np.mean(np.gradient(h, x) ** 2)))
+
+    for seed in range(5):
+        narrow = rough_profile(np.random.default_rng(seed), w, amp, 4)
+        kept = rough_profile(np.random.default_rng(seed), 16 * w, amp, 64, 16)
+        long = rough_profile(np.random.default_rng(seed), 16 * w, amp, 64)
+        assert kept[0][0] == 16 and kept[0][-1] == 64 and kept[0].size == 49
+        s1 = rms_slope(w, narrow)
+        assert 0.4 < rms_slope(16 * w, kept) / s1 < 1.2
+        assert rms_slope(16 * w, long) / s1 < 0.35
+    with pytest.raises(ValueError, match="first_mode"):
+        Geometry(modes=4, first_mode=5).check(1e-6)
+
+
 def test_interface_geometry_and_boundary_conditions() -> None:
     it = build_interface(SMALL, 0.33e6)
     p = it.sim.p

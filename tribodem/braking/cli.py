@@ -69,6 +69,9 @@ class GeometryCfg(_Strict):
     pad_height_m: float = Field(108e-6, gt=0)
     roughness_amplitude_m: float = Field(8e-6, ge=0)
     roughness_modes: int = Field(4, ge=1, le=64)
+    roughness_first_mode: int = Field(
+        1, ge=1, le=64, description="lowest sine mode k (wavelength width/k); in a cell n "
+        "times the default width, n keeps the default cell's wavelengths and asperities")
     clearance_m: float = Field(5e-8, ge=0)
     seed: int = Field(0, ge=0)
 
@@ -165,7 +168,7 @@ def setup_from_config(cfg: BrakingConfig) -> Any:
     g = cfg.geometry
     geo = Geometry(width=g.width_m, disc_height=g.disc_height_m, pad_height=g.pad_height_m,
                    amplitude=g.roughness_amplitude_m, modes=g.roughness_modes,
-                   clearance=g.clearance_m, seed=g.seed)
+                   first_mode=g.roughness_first_mode, clearance=g.clearance_m, seed=g.seed)
     from tribodem.braking.model import materials
 
     rmax = max(m.radius_range[1] for m in materials(cfg.run.micro))

@@ -83,8 +83,8 @@ def materials(micro: str = "calibrated") -> tuple[MaterialSpec, MaterialSpec]:
 @dataclass
 class Geometry:
     """Sizes (m) of the interface cell: periodic ``width``, disc and pad heights,
-    roughness ``amplitude`` (max |profile|) with ``modes`` sine modes of wavelengths
-    W/1..W/modes, packing ``seed``. Start: the pad's lowest point ``clearance`` above the
+    roughness ``amplitude`` (max |profile|) with sine modes k = ``first_mode``..``modes``
+    (wavelengths W/k), packing ``seed``. Start: the pad's lowest point ``clearance`` above the
     disc's highest point (the pad is applied to the sliding disc), ``compaction_stress``
     (Pa) of the packing."""
 
@@ -93,6 +93,7 @@ class Geometry:
     pad_height: float = 100e-6
     amplitude: float = 10e-6
     modes: int = 4
+    first_mode: int = 1
     clearance: float = 5e-8
     seed: int = 0
     compaction_stress: float = 1.0e6
@@ -109,6 +110,9 @@ class Geometry:
                              "[0, 0.3 x the smaller body height]")
         if not 1 <= self.modes <= 64:
             raise ValueError(f"geometry: modes = {self.modes!r}: must be in [1, 64]")
+        if not 1 <= self.first_mode <= self.modes:
+            raise ValueError(f"geometry: first_mode = {self.first_mode!r}: must be in "
+                             f"[1, modes = {self.modes}]")
         if not self.clearance >= 0:
             raise ValueError(f"geometry: clearance = {self.clearance!r} m: must be >= 0")
 
@@ -212,14 +216,18 @@ def compact_periodic(spec: MaterialSpec, width: float, height: float, seed: int,
                                 "loose_fraction": float(np.count_nonzero(deg == 0)) / n}
 
 
-def rough_profile(rng: np.random.Generator, width: float, amplitude: float, modes: int
-                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """A random periodic profile: sine modes k = 1..modes (wavelength W/k), amplitudes
-    U(0.3, 1)/k, random phases, scaled so max |h| = ``amplitude``. Returns
-    (k, amplitude per mode, phase per mode) for ``profile_height``."""
-    k = np.arange(1, modes + 1, dtype=float)
-    a = rng.uniform(0.3, 1.0, size=modes) / k
-    ph = rng.uniform(0.0, 2.0 * math.pi, size=modes)
+def rough_profile(rng: np.random.Generator, width: float, amplitude: float, modes: int,
+                  first: int = 1) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A random periodic profile: sine modes k = first..modes (wavelength W/k), amplitudes
+    U(0.3, 1)/k (proportional to the wavelength), random phases, scaled so max |h| =
+    ``amplitude``. Returns (k, amplitude per mode, phase per mode) for
+    ``profile_height``. A cell n times wider with ``first`` = n and ``modes`` n times
+    larger has the narrow cell's wavelengths and relative amplitudes (its asperities);
+    with ``first`` = 1 its longest waves take the amplitude and the asperities shrink ~n
+    times."""
+    k = np.arange(first, modes + 1, dtype=float)
+    a = rng.uniform(0.3, 1.0, size=k.size) / k
+    ph = rng.uniform(0.0, 2.0 * math.pi, size=k.size)
     x = np.linspace(0.0, width, 2049)
     h = (a[None, :] * np.sin(2 * math.pi * k[None, :] * x[:, None] / width + ph)).sum(axis=1)
     scale = amplitude / max(float(np.abs(h).max()), 1e-300)
@@ -396,8 +404,8 @@ def build_interface(geometry: Geometry, pressure_Pa: float, micro: str = "calibr
                       f"<= {100 * LOOSE_MAX:.0f} %)", stacklevel=2)
     phi_c = float(math.pi * (radii**2).sum() / (w * total))
     rng = np.random.default_rng(g.seed + 7919)
-    prof_d = rough_profile(rng, w, g.amplitude, g.modes)
-    prof_p = rough_profile(rng, w, g.amplitude, g.modes)
+    prof_d = rough_profile(rng, w, g.amplitude, g.modes, g.first_mode)
+    prof_p = rough_profile(rng, w, g.amplitude, g.modes, g.first_mode)
     x, y = pos[:, 0], pos[:, 1]
     y_mid = g.disc_height + g.amplitude
     hd = y_mid + profile_height(x, w, prof_d)

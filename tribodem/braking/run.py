@@ -302,6 +302,8 @@ def setup_record(setup: RunSetup) -> dict[str, Any]:
     d = asdict(setup)
     for k in RESUME_FREE:
         d.pop(k)
+    if d["geometry"]["first_mode"] == 1:  # at its default: as recorded before it existed
+        del d["geometry"]["first_mode"]
     d["thermal_curve"] = None if setup.thermal_curve is None else str(setup.thermal_curve)
     return json.loads(json.dumps(d))
 
@@ -693,6 +695,7 @@ def run_braking(setup: RunSetup, out: Path | None = None, *, resume: bool = Fals
         "disc_height_m": setup.geometry.disc_height,
         "pad_height_m": setup.geometry.pad_height,
         "roughness_amplitude_m": setup.geometry.amplitude,
+        "roughness_modes": [setup.geometry.first_mode, setup.geometry.modes],
         "packing_fraction": iface.phi[DISC],
         "build_stats": iface.stats,
         "micro_parameters": {"disc": iface.disc.micro_dict(), "pad": iface.pad.micro_dict(),
@@ -781,8 +784,10 @@ def _assumptions(setup: RunSetup) -> list[str]:
             "tied to the rest of the pad by non-reflecting (Lysmer) dashpots, rho c_p "
             "relative to the plate in y and rho c_s in x (the support)"
             if setup.backing == "absorbing" else "held in x (support wall), free face in y"),
-        "rough surfaces: independent random profiles (sine modes W/1..W/modes) cut from one "
-        "compacted block; pad lowered vertically to first contact",
+        "rough surfaces: independent random profiles (sine modes of wavelengths W/k, k = "
+        f"{setup.geometry.first_mode}..{setup.geometry.modes}, amplitudes ~ U(0.3, 1)/k, "
+        "max |h| = the amplitude) cut from one compacted block; pad lowered vertically to "
+        "first contact",
         "wear depth = detached solid area / (packing fraction x width), pad (the seed "
         "analyses the pad); detached = not connected by intact bonds to an anchored layer",
     ]
