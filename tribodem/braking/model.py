@@ -111,8 +111,8 @@ class Geometry:
         if not 1 <= self.modes <= 64:
             raise ValueError(f"geometry: modes = {self.modes!r}: must be in [1, 64]")
         if not 1 <= self.first_mode <= self.modes:
-            raise ValueError(f"geometry: first_mode = {self.first_mode!r}: must be in "
-                             f"[1, modes = {self.modes}]")
+            raise ValueError(f"geometry: first_mode (config: roughness_first_mode) = "
+                             f"{self.first_mode!r}: must be in [1, modes = {self.modes}]")
         if not self.clearance >= 0:
             raise ValueError(f"geometry: clearance = {self.clearance!r} m: must be >= 0")
 
