@@ -302,8 +302,6 @@ def setup_record(setup: RunSetup) -> dict[str, Any]:
     d = asdict(setup)
     for k in RESUME_FREE:
         d.pop(k)
-    if d["geometry"]["first_mode"] == 1:  # at its default: as recorded before it existed
-        del d["geometry"]["first_mode"]
     d["thermal_curve"] = None if setup.thermal_curve is None else str(setup.thermal_curve)
     return json.loads(json.dumps(d))
 
@@ -328,10 +326,19 @@ def read_checkpoint(path: str | Path) -> dict[str, Any]:
     return rec
 
 
+#: setup fields added after checkpoints were first written, with the value the run of an
+#: older checkpoint (which does not record them) had
+ADDED_FIELDS = {("geometry", "first_mode"): 1}
+
+
 def check_resumable(rec: dict[str, Any], setup: RunSetup, path: str | Path) -> None:
     """``ConfigError`` naming the first setup field that differs from the checkpoint's run
-    (only ``checkpoint_every`` and ``figures`` may change)."""
-    diff = differences(rec["setup"], setup_record(setup))
+    (only ``checkpoint_every`` and ``figures`` may change); an older checkpoint's missing
+    fields count as their ``ADDED_FIELDS`` values."""
+    old = json.loads(json.dumps(rec["setup"]))
+    for (group, key), value in ADDED_FIELDS.items():
+        old.get(group, {}).setdefault(key, value)
+    diff = differences(old, setup_record(setup))
     if diff:
         name, old, new = diff[0]
         raise ConfigError(
