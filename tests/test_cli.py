@@ -18,6 +18,7 @@ def tribodem(*args: str) -> subprocess.CompletedProcess:
 def test_version() -> None:
     r = tribodem("--version")
     assert r.returncode == 0 and r.stdout.startswith("tribodem ")
+    assert "\nccx: " in r.stdout  # the ccx the finite-element backends run, or how to install it
 
 
 def test_bench_quick_json() -> None:

@@ -146,15 +146,17 @@ def test_missing_ccx_names_the_install_command(tmp_path: Path,
 
 def test_which_ccx_runs(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """resolve_ccx: the caller's name, else $TRIBODEM_CCX, else ccx_pardiso (PATH, then
-    this Python's bin), else ccx; ccx_solvers reads the solvers built into a binary."""
-    from tribodem.contact.fe import ccx_solvers, resolve_ccx
+    this Python's bin), else ccx; ccx_solvers reads the solvers built into a binary,
+    ccx_patches tribodem's patches, ccx_build all of it for a summary."""
+    from tribodem.contact.fe import CCX_PATCHES, ccx_build, ccx_patches, ccx_solvers, resolve_ccx
 
     bin_dir, prefix = tmp_path / "bin", tmp_path / "prefix"
     (prefix / "bin").mkdir(parents=True)
     bin_dir.mkdir()
     for name, text in (("ccx", "using the unsymmetric spooles solver"),
                        ("ccx_pardiso", "using the unsymmetric pardiso solver\0"
-                                       "using the unsymmetric spooles solver")):
+                                       "using the unsymmetric spooles solver\0"
+                                       + "\0".join(m.decode() for m in CCX_PATCHES.values()))):
         exe = bin_dir / name
         exe.write_text(f"#!/bin/sh\n# {text}\n")
         exe.chmod(0o755)
@@ -164,6 +166,11 @@ def test_which_ccx_runs(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None
     assert resolve_ccx() == str(bin_dir / "ccx_pardiso")
     assert ccx_solvers(str(bin_dir / "ccx_pardiso")) == ["PARDISO", "SPOOLES"]
     assert ccx_solvers(str(bin_dir / "ccx")) == ["SPOOLES"]
+    assert ccx_patches(str(bin_dir / "ccx_pardiso")) == list(CCX_PATCHES)
+    assert ccx_patches(str(bin_dir / "ccx")) == []
+    build = ccx_build(str(bin_dir / "ccx_pardiso"))
+    assert build["solvers"] == ["PARDISO", "SPOOLES"] and build["patches"] == list(CCX_PATCHES)
+    assert build["version"] == "version unknown"  # the stand-in prints no version line
     monkeypatch.setenv("TRIBODEM_CCX", "ccx")
     assert resolve_ccx() == str(bin_dir / "ccx")
     assert resolve_ccx("ccx_pardiso") == str(bin_dir / "ccx_pardiso")  # the caller's wins

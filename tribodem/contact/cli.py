@@ -68,18 +68,13 @@ def validate(
 
 def ccx_version() -> str:
     """The CalculiX ``ccx`` the finite-element backends run (``resolve_ccx``: its path,
-    version line and direct solvers), or how to install it."""
-    import subprocess
-
-    from tribodem.contact.fe.ccx import INSTALL_COMMAND, ccx_solvers, resolve_ccx
+    version line, direct solvers and tribodem's patches), or how to install it."""
+    from tribodem.contact.fe.ccx import INSTALL_COMMAND, ccx_build, resolve_ccx
 
     exe = resolve_ccx()
     if exe is None:
         return f"ccx: not found ({INSTALL_COMMAND})"
-    solvers = ", ".join(ccx_solvers(exe)) or "solvers unknown"
-    try:
-        out = subprocess.run([exe, "-v"], capture_output=True, text=True, timeout=10).stdout
-    except (OSError, subprocess.TimeoutExpired):
-        return f"ccx: {exe} (version unknown; {solvers})"
-    line = next((x.strip() for x in out.splitlines() if "Version" in x), "version unknown")
-    return f"ccx: {exe} ({line}; {solvers})"
+    b = ccx_build(exe)
+    solvers = ", ".join(b["solvers"]) or "solvers unknown"
+    patches = f"; patches: {', '.join(b['patches'])}" if b["patches"] else ""
+    return f"ccx: {exe} ({b['version']}; {solvers}{patches})"

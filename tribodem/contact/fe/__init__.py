@@ -9,12 +9,15 @@ one-call runs (:mod:`.model`) and closed-form checks (:mod:`.validate`, also
 """
 
 from tribodem.contact.fe.ccx import (
+    CCX_PATCHES,
     INSTALL_COMMAND,
     CcxConvergenceError,
     CcxError,
     CcxNotFoundError,
     CcxRun,
     CcxTimeoutError,
+    ccx_build,
+    ccx_patches,
     ccx_solvers,
     find_ccx,
     resolve_ccx,
@@ -32,6 +35,7 @@ from tribodem.contact.fe.results import (
 )
 
 __all__ = [
+    "CCX_PATCHES",
     "INSTALL_COMMAND",
     "CcxConvergenceError",
     "CcxError",
@@ -48,6 +52,8 @@ __all__ = [
     "Mesh",
     "PadOnFlat",
     "build",
+    "ccx_build",
+    "ccx_patches",
     "ccx_solvers",
     "cylinder_on_flat",
     "find_ccx",

@@ -66,6 +66,7 @@ from tribodem.contact.base import (
 from tribodem.contact.elastoplastic import PlasticStep
 from tribodem.contact.fe.ccx import (
     FESolverStopped,
+    ccx_build,
     find_ccx,
 )
 from tribodem.contact.fe.deck import LoadCase, sliding_contact, write_deck
@@ -866,6 +867,7 @@ class FEContactSolver(CcxJobs, FirstBodySolver):
         the cycle's first and last quarters and the drop between them (last / first - 1),
         |Q| / (mu P) at +A and -A."""
         return {"backend": "fe", "mode": self.mode, "material": self.material,
+                "ccx": ccx_build(self.executable),
                 "chain_cycles": self.chain_cycles if self.mode == "chained" else None,
                 "chain_restarts": self.chain_restarts, "profile": self.profile(),
                 "cycles": list(self.cycle_reports)}

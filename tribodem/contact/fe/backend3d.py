@@ -81,6 +81,7 @@ from tribodem.contact.fe.backend import (
 )
 from tribodem.contact.fe.ccx import (
     FESolverStopped,
+    ccx_build,
     find_ccx,
 )
 from tribodem.contact.fe.crossed import (
@@ -1212,6 +1213,7 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         after lifting the upper body off; the largest shear traction in the cycle's first
         and last quarters and the drop between them, |Q| / (mu P) at +A and -A."""
         return {"backend": "fe3d", "mode": self.mode, "material": self.material,
+                "ccx": ccx_build(self.executable),
                 "fe3d": {"elements": int(self._mesh0.elements.shape[0]),
                          "h_fine_m": self._mesh0.h_fine, "size_factor": self.size_factor},
                 "profile": self.profile(), "cycles": list(self.cycle_reports)}

@@ -23,6 +23,7 @@
 
 from __future__ import annotations
 
+import functools
 import os
 import shutil
 import signal
@@ -31,6 +32,7 @@ import sys
 import time
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 #: the one command that installs the solver (Debian/Ubuntu package of CalculiX 2.20)
 INSTALL_COMMAND = "apt-get install -y calculix-ccx"
@@ -125,6 +127,49 @@ def ccx_solvers(path: str) -> list[str]:
         return []
     return [name for name in ("PARDISO", "SPOOLES")
             if f"using the unsymmetric {name.lower()} solver".encode() in data]
+
+
+#: tribodem's ccx patches (``tools/*.patch``, applied by ``tools/build_ccx_pardiso``; docs/fe3d.md
+#: "Two ccx patches"), each found by a message only the patched binary carries
+CCX_PATCHES = {
+    "pardiso_analysis_kept": b"in pardiso_main: PARDISO error",
+    "contact_divergence": b"the residual rose in two iterations running",
+}
+
+
+def ccx_patches(path: str) -> list[str]:
+    """tribodem's patches (:data:`CCX_PATCHES`) built into the ccx at ``path``."""
+    try:
+        data = Path(path).read_bytes()
+    except OSError:
+        return []
+    return [name for name, marker in CCX_PATCHES.items() if marker in data]
+
+
+@functools.lru_cache(maxsize=8)
+def _ccx_build(path: str, size: int, mtime_ns: int) -> tuple[str, tuple[str, ...],
+                                                             tuple[str, ...]]:
+    del size, mtime_ns  # the cache key: a rebuilt binary is read again
+    try:
+        out = subprocess.run([path, "-v"], capture_output=True, text=True, timeout=10).stdout
+        line = next((x.strip() for x in out.splitlines() if "Version" in x), "version unknown")
+    except (OSError, subprocess.TimeoutExpired):
+        line = "version unknown"
+    return line, tuple(ccx_solvers(path)), tuple(ccx_patches(path))
+
+
+def ccx_build(path: str) -> dict[str, Any]:
+    """Which ccx ran, for summaries and ``--version``: ``executable`` (path), ``version``
+    (its version line), ``solvers`` (:func:`ccx_solvers`, the default first) and
+    ``patches`` (:func:`ccx_patches`). Results of two builds agree within the solver's
+    tolerances, not in every digit (docs/fe3d.md)."""
+    try:
+        st = Path(path).stat()
+    except OSError:
+        return {"executable": path, "version": "not found", "solvers": [], "patches": []}
+    line, solvers, patches = _ccx_build(path, st.st_size, st.st_mtime_ns)
+    return {"executable": path, "version": line, "solvers": list(solvers),
+            "patches": list(patches)}
 
 
 def _last_sta_line(job: Path) -> str:
