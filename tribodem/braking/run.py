@@ -335,10 +335,10 @@ def check_resumable(rec: dict[str, Any], setup: RunSetup, path: str | Path) -> N
     """``ConfigError`` naming the first setup field that differs from the checkpoint's run
     (only ``checkpoint_every`` and ``figures`` may change); an older checkpoint's missing
     fields count as their ``ADDED_FIELDS`` values."""
-    old = json.loads(json.dumps(rec["setup"]))
+    recorded = json.loads(json.dumps(rec["setup"]))
     for (group, key), value in ADDED_FIELDS.items():
-        old.get(group, {}).setdefault(key, value)
-    diff = differences(old, setup_record(setup))
+        recorded.get(group, {}).setdefault(key, value)
+    diff = differences(recorded, setup_record(setup))
     if diff:
         name, old, new = diff[0]
         raise ConfigError(

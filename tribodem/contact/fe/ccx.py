@@ -118,15 +118,24 @@ def find_ccx(executable: str | None = None) -> str:
     return path
 
 
-def ccx_solvers(path: str) -> list[str]:
-    """The direct solvers built into the ccx at ``path`` (``PARDISO``, ``SPOOLES``), read
-    from the messages in the binary; the first is the one ccx uses by default."""
+def _markers_in(path: str, markers: dict[str, bytes]) -> list[str]:
+    """The names of ``markers`` whose bytes occur in the file at ``path`` (none if unreadable)."""
     try:
         data = Path(path).read_bytes()
     except OSError:
         return []
-    return [name for name in ("PARDISO", "SPOOLES")
-            if f"using the unsymmetric {name.lower()} solver".encode() in data]
+    return [name for name, marker in markers.items() if marker in data]
+
+
+#: the direct solvers a ccx can be built with, each found by its factorisation message
+CCX_SOLVERS = {name: f"using the unsymmetric {name.lower()} solver".encode()
+               for name in ("PARDISO", "SPOOLES")}
+
+
+def ccx_solvers(path: str) -> list[str]:
+    """The direct solvers built into the ccx at ``path`` (``PARDISO``, ``SPOOLES``), read
+    from the messages in the binary; the first is the one ccx uses by default."""
+    return _markers_in(path, CCX_SOLVERS)
 
 
 #: tribodem's ccx patches (``tools/*.patch``, applied by ``tools/build_ccx_pardiso``; docs/fe3d.md
@@ -139,11 +148,7 @@ CCX_PATCHES = {
 
 def ccx_patches(path: str) -> list[str]:
     """tribodem's patches (:data:`CCX_PATCHES`) built into the ccx at ``path``."""
-    try:
-        data = Path(path).read_bytes()
-    except OSError:
-        return []
-    return [name for name, marker in CCX_PATCHES.items() if marker in data]
+    return _markers_in(path, CCX_PATCHES)
 
 
 @functools.lru_cache(maxsize=8)
@@ -155,7 +160,9 @@ def _ccx_build(path: str, size: int, mtime_ns: int) -> tuple[str, tuple[str, ...
         line = next((x.strip() for x in out.splitlines() if "Version" in x), "version unknown")
     except (OSError, subprocess.TimeoutExpired):
         line = "version unknown"
-    return line, tuple(ccx_solvers(path)), tuple(ccx_patches(path))
+    found = _markers_in(path, CCX_SOLVERS | CCX_PATCHES)  # one read of the binary
+    return (line, tuple(n for n in found if n in CCX_SOLVERS),
+            tuple(n for n in found if n in CCX_PATCHES))
 
 
 def ccx_build(path: str) -> dict[str, Any]:
