@@ -71,7 +71,15 @@ from tribodem.contact.fe.ccx import (
 )
 from tribodem.contact.fe.deck import LoadCase, sliding_contact, write_deck
 from tribodem.contact.fe.jobs import CcxJobs, JobRecord, check_stress_depth, run_job
-from tribodem.contact.fe.mesh import Mesh, PadOnFlat, cylinder_on_flat, hertz_line, morph_columns
+from tribodem.contact.fe.mesh import (
+    Mesh,
+    PadOnFlat,
+    cylinder_on_flat,
+    hertz_line,
+    morph_columns,
+    surface_projection,
+    worn_depth,
+)
 from tribodem.contact.fe.mesh import worn_area as mesh_worn_area
 from tribodem.contact.fe.results import GAUSS_2X2, FEResults, ip_coordinates, read_results
 from tribodem.contact.geometry import cylinder, flat, line_window
@@ -369,10 +377,12 @@ class FEContactSolver(CcxJobs, FirstBodySolver):
         return mesh
 
     def column_wear(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """Worn depth (m, >= 0) at each node column of the (upper, lower) mesh: the current
-        recession minus the unworn one at the column's x (pad frame for the upper body, lab
-        frame for the lower one), y = 0; zero outside the window (upper) and outside the
-        window plus the stroke (lower), where the surfaces are not given."""
+        """Worn depth (m, >= 0) of each node column of the (upper, lower) mesh: the lumped
+        projection (:func:`surface_projection`, sampled at dx / 2) of the current recession
+        minus the unworn one at y = 0 (pad frame for the upper body, lab frame for the lower
+        one, clipped at zero) onto the surface nodes; zero outside the window (upper) and
+        outside the window plus the stroke (lower), where the surfaces are not given. The
+        morphed mesh so loses the loop's worn area."""
         out = []
         c = self.coords
         pad = (math.ceil(self.amplitude / self.dx) + 1) * self.dx  # the loop's track grid
@@ -380,12 +390,8 @@ class FEContactSolver(CcxJobs, FirstBodySolver):
                 ("upper", self.upper, self._base_upper, c[0], c[-1]),
                 ("lower", self.lower, self._base_lower, c[0] - pad, c[-1] + pad)):
             x = self._mesh0.nodes[self._mesh0.columns[body][:, 0], 0]
-            inside = (x >= lo) & (x <= hi)  # the surfaces are given on the window / track
-            w = np.zeros_like(x)
-            xi, yi = x[inside], np.zeros(int(inside.sum()))
-            w[inside] = np.asarray(now(xi, yi), dtype=float) - np.asarray(base(xi, yi),
-                                                                          dtype=float)
-            out.append(np.maximum(w, 0.0))
+            out.append(surface_projection(worn_depth(now, base), x, None,
+                                      (lo, hi, -np.inf, np.inf), 0.5 * self.dx))
         return out[0], out[1]
 
     def morphed_mesh(self) -> Mesh:

@@ -97,11 +97,13 @@ from tribodem.contact.fe.crossed import (
 from tribodem.contact.fe.deck import (
     ContactSettings,
     _fmt,
+    _static,
     _time_points,
     _write_ids,
     sliding_contact,
 )
 from tribodem.contact.fe.jobs import CcxJobs, JobRecord, check_stress_depth, run_job
+from tribodem.contact.fe.mesh import surface_projection, worn_depth
 from tribodem.contact.fe.results import DatBlock, read_dat
 from tribodem.contact.geometry import HertzSphere, crossed_cylinders
 from tribodem.contact.halfspace import max_shear, von_mises
@@ -117,11 +119,12 @@ FRETTING3D_SIZE_FACTOR = 8.0
 FRETTING3D_GROWTH = 1.4
 #: contact penalty of the 3D backend: normal stiffness = factor x E_min / h, Pa/m
 PENALTY_FACTOR = 10.0
-#: elastic-plastic cycles: the first ccx increment of each quarter (each starts at a
-#: reversal, where the whole contact sticks again) slides this fraction of the Mindlin
-#: gross-slip displacement (ccx then grows it). Started at the largest increment, the
-#: seed's first reversal needed 5 cut-backs, ccx's limit (two PARDISO threads: 6, "too
-#: many cutbacks"); from 1/4 of it, 1-3 (docs/fe3d.md, measured)
+#: the first ccx increment of each quarter of the cycle (each starts at a reversal, where
+#: the whole contact sticks again) slides this fraction of the Mindlin gross-slip
+#: displacement (ccx then grows it). Started at the largest increment, the seed's first
+#: elastic-plastic reversal needed 5 cut-backs, ccx's limit (two PARDISO threads: 6, "too
+#: many cutbacks"); from 1/4 of it, 1-3; the elastic quick case (+-0.3 mm, 48 increments)
+#: stopped at its first reversal after 6 (docs/fe3d.md, measured)
 REVERSAL_SLIDE = 0.25
 
 #: modes of :class:`FE3DContactSolver` (``chained`` is the 2D backend's only)
@@ -513,23 +516,19 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         return mesh
 
     def column_wear(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """Worn depth (m, >= 0) at each node column (j, i) of the (upper, lower) mesh, [ny,
-        nx]: the current recession minus the unworn one at the column's (x, y) (upper: its
-        own frame, lower: lab frame); zero outside the window (upper) and the window plus the
-        stroke (lower) along x, and beyond the window's last point along y, where the loop
-        gives no surface."""
+        """Worn depth (m, >= 0) of each node column (j, i) of the (upper, lower) mesh, [ny,
+        nx]: the lumped projection (:func:`surface_projection`, sampled at dx / 2) of the
+        current recession minus the unworn one (upper: its own frame, lower: lab frame,
+        clipped at zero) onto the surface nodes; zero outside the window (upper) and the
+        window plus the stroke (lower) along x, and beyond the window's last point along y,
+        where the loop gives no surface. The morphed mesh so loses the loop's worn volume."""
         c = self.coords
         out = []
         for body, now, base, lo, hi in (
                 ("upper", self.upper, self._base_upper, c[0], c[-1]),
                 ("lower", self.lower, self._base_lower, c[0] - self.pad, c[-1] + self.pad)):
-            x, y = np.meshgrid(*self._grids[body])
-            inside = (x >= lo) & (x <= hi) & (y <= c[-1])
-            w = np.zeros_like(x)
-            xi, yi = x[inside], y[inside]
-            w[inside] = (np.asarray(now(xi, yi), dtype=float)
-                         - np.asarray(base(xi, yi), dtype=float))
-            out.append(np.maximum(w, 0.0))
+            out.append(surface_projection(worn_depth(now, base), *self._grids[body],
+                                      (lo, hi, -np.inf, c[-1]), 0.5 * self.dx))
         return out[0], out[1]
 
     def morphed_mesh(self) -> Mesh3D:
@@ -652,25 +651,24 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
                        if self.plastic else ""))
 
         refine = max(int(refine), 1)
-        out.write("*STEP, INC=200\n*STATIC\n0.5, 1., 1e-4, 0.5\n")
+        out.write("*STEP, INC=200\n" + _static(0.5, 1.0, 1e-4, 0.5))
         out.write(friction(s.mu_loading, s.stick_factor_loading))
         out.write(f"*BOUNDARY\n{ref}, 1, 1, 0.\n{ref}, 3, 3, {_fmt(-seat)}\n*END STEP\n")
         dt = 1.0 / (n_load * refine)
-        out.write(f"*STEP, INC=1000\n*STATIC\n{dt}, 1., {dt * 1e-4}, {dt}\n")
+        out.write("*STEP, INC=1000\n" + _static(dt, 1.0, dt * 1e-4, dt))
         out.write("*BOUNDARY, OP=NEW\n" + fixed + f"{ref}, 1, 1, 0.\n")
         out.write(f"*CLOAD\n{ref}, 3, {_fmt(-self.load / 2.0)}\n")
         debris = self._debris_faces(mesh) if self._debris_load > 0.0 else ""
         out.write(debris)
         out.write(outputs("TLOAD") + "*END STEP\n")
         dt = 4.0 / (self.n_increments * refine * self.cycle_refine)
-        dt0 = dt
-        if self.plastic:  # each quarter starts at a reversal: first slide REVERSAL_SLIDE delta
-            dt0 = min(dt, REVERSAL_SLIDE * self.gross_slip_displacement / self.amplitude)
+        # each quarter starts at a reversal: first slide REVERSAL_SLIDE delta
+        dt0 = min(dt, REVERSAL_SLIDE * self.gross_slip_displacement / self.amplitude)
         targets = (self.amplitude, 0.0, -self.amplitude, 0.0)
         if self._primed():  # the previous cycle's second half: a continuous test's history
             targets = (-self.amplitude, 0.0) + targets
         for k, target in enumerate(targets):
-            out.write(f"*STEP, INC=10000\n*STATIC\n{dt0}, 1., {min(dt0, dt * 1e-4)}, {dt}\n")
+            out.write("*STEP, INC=10000\n" + _static(dt0, 1.0, min(dt0, dt * 1e-4), dt))
             if k == 0:
                 out.write(friction(s.mu, s.stick_factor))
             out.write(f"*BOUNDARY\n{ref}, 1, 1, {_fmt(target)}\n")
@@ -678,7 +676,7 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         if self.plastic:  # lift the upper body off, load removed: the residual surfaces
             a = self.hertz[1]
             dt = 1.0 / (n_load * refine)
-            out.write(f"*STEP, INC=1000\n*STATIC\n{dt}, 1., {dt * 1e-4}, {dt}\n")
+            out.write("*STEP, INC=1000\n" + _static(dt, 1.0, dt * 1e-4, dt))
             out.write("*BOUNDARY, OP=NEW\n" + fixed + f"{ref}, 1, 1, 0.\n"
                       f"{ref}, 3, 3, {_fmt(2.0 * a * a / self.radius)}\n"
                       f"*CLOAD, OP=NEW\n{ref}, 3, 0.\n")

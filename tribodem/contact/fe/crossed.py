@@ -38,7 +38,7 @@ from numpy.typing import NDArray
 
 from tribodem.contact.base import ElasticBody, contact_modulus
 from tribodem.contact.fe.ccx import run_ccx
-from tribodem.contact.fe.deck import FEMaterial, _fmt, _time_points, _write_ids
+from tribodem.contact.fe.deck import FEMaterial, _fmt, _static, _time_points, _write_ids
 from tribodem.contact.fe.mesh import graded_half, graded_symmetric
 from tribodem.contact.fe.results import read_dat, tributary_length
 from tribodem.contact.geometry import HertzSphere
@@ -290,7 +290,7 @@ def write_crossed_deck(path: str | Path, mesh: Mesh3D, case: CrossedCase) -> Pat
     out.write(fixed)
     _, a = case.hertz
     seat = 0.05 * a * a / case.radius  # 5 % of the Hertz approach a^2 / R
-    out.write("*STEP, INC=200\n*STATIC\n0.5, 1., 1e-4, 0.5\n")
+    out.write("*STEP, INC=200\n" + _static(0.5, 1.0, 1e-4, 0.5))
     out.write(f"*BOUNDARY\n{hold}{ref}, 3, 3, {_fmt(-seat)}\n*END STEP\n")
     dt = 1.0 / n
     outputs = ("*NODE PRINT, NSET=LBOT, TOTALS=ONLY, TIME POINTS={tp}\nRF\n"
@@ -298,14 +298,14 @@ def write_crossed_deck(path: str | Path, mesh: Mesh3D, case: CrossedCase) -> Pat
                "*NODE PRINT, NSET=UBOT, TIME POINTS={tp}\nU\n"
                "*NODE PRINT, NSET=LTOP, TIME POINTS={tp}\nU\n"
                "*EL PRINT, ELSET=UCONT, TIME POINTS={tp}\nS\n")
-    out.write(f"*STEP, INC=1000\n*STATIC\n{dt}, 1., {dt * 1e-4}, {dt}\n")
+    out.write("*STEP, INC=1000\n" + _static(dt, 1.0, dt * 1e-4, dt))
     out.write("*BOUNDARY, OP=NEW\n" + fixed.split("\n", 1)[1] + hold)
     out.write(f"*CLOAD\n{ref}, 3, {_fmt(-case.load / (2.0 if case.half else 4.0))}\n")
     out.write(outputs.format(tp="TLOAD") + "*END STEP\n")
     if case.half:
         dt = 4.0 / nt
         total = 1.0 if case.half_cycle else 4.0
-        out.write(f"*STEP, INC=10000\n*STATIC\n{dt}, {total}, {dt * 1e-4}, {dt}\n")
+        out.write("*STEP, INC=10000\n" + _static(dt, total, dt * 1e-4, dt))
         if friction:
             out.write("*CHANGE FRICTION, INTERACTION=SI\n"
                       f"*FRICTION\n{case.mu}, {_fmt(case.stick_factor * k_n)}\n")

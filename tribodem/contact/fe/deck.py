@@ -218,6 +218,15 @@ def _change_friction(out: io.StringIO, mesh: Mesh, lower: FEMaterial, upper: FEM
         out.write(f"*CONTACT PAIR, INTERACTION=SI, TYPE={contact.formulation}\nSPAD, SFLAT\n")
 
 
+def _static(initial: float, period: float, minimum: float, maximum: float) -> str:
+    """A ``*STATIC`` keyword with its data line: initial increment, step period, minimum and
+    maximum increment (step time). ccx reads each field as at most 20 characters: a
+    ``repr`` such as ``8.333333333333334e-06`` (21) loses its exponent's last digit and
+    became a minimum increment of 8.3 (ccx: "a time point precedes the minimum time tmin"),
+    so 12 significant digits, as the time points are written."""
+    return "*STATIC\n" + ", ".join(f"{v:.12g}" for v in (initial, period, minimum, maximum)) + "\n"
+
+
 def _time_points(out: io.StringIO, name: str, times: np.ndarray) -> None:
     out.write(f"*TIME POINTS, NAME={name}\n")
     for k in range(0, times.size, 8):
@@ -282,7 +291,7 @@ def write_deck(path: str | Path, mesh: Mesh, case: LoadCase,
         r_n, c_n = case.field_controls
         controls = f"*CONTROLS, PARAMETERS=FIELD\n{r_n}, {c_n}\n"
     # step 1: seating under displacement control
-    out.write("*STEP, INC=200\n*STATIC\n0.5, 1., 1e-4, 0.5\n")
+    out.write("*STEP, INC=200\n" + _static(0.5, 1.0, 1e-4, 0.5))
     _change_friction(out, mesh, lower, upper, contact, loading=True)
     out.write(f"*BOUNDARY\n{ref}, 1, 1, 0.\n{ref}, 2, 2, {_fmt(-seat)}\n")
     _outputs(out, plastic, fine_stress, frd, "", stress_sets)
@@ -290,7 +299,7 @@ def write_deck(path: str | Path, mesh: Mesh, case: LoadCase,
     # step 2: normal load P on REF (automatic increments <= 1 / n_load, output at 1 / n_load)
     refine = max(int(case.refine), 1)
     dt = 1.0 / (n_load * refine)
-    out.write(f"*STEP, INC=1000\n*STATIC\n{dt}, 1., {dt * 1e-4}, {dt}\n")
+    out.write("*STEP, INC=1000\n" + _static(dt, 1.0, dt * 1e-4, dt))
     out.write(f"*BOUNDARY, OP=NEW\nLBOT, 1, 2\n{ref}, 1, 1, 0.\n")
     out.write(f"*CLOAD\n{ref}, 2, {_fmt(-case.load)}\n" + controls)
     _outputs(out, plastic, fine_stress, frd, "TLOAD", stress_sets)
@@ -303,7 +312,7 @@ def write_deck(path: str | Path, mesh: Mesh, case: LoadCase,
             :1 if case.half_cycle else None]
         dt = 4.0 / (n * refine * max(int(case.cycle_refine), 1))
         for k, target in enumerate(targets):
-            out.write(f"*STEP, INC=10000\n*STATIC\n{dt}, 1., {dt * 1e-4}, {dt}\n")
+            out.write("*STEP, INC=10000\n" + _static(dt, 1.0, dt * 1e-4, dt))
             if k == 0:
                 _change_friction(out, mesh, lower, upper, contact, loading=False)
             out.write(f"*BOUNDARY\n{ref}, 1, 1, {_fmt(target)}\n" + controls)
@@ -312,14 +321,14 @@ def write_deck(path: str | Path, mesh: Mesh, case: LoadCase,
         if case.unload:  # REF to a height where the surfaces have separated, load removed
             lift = 2.0 * a * a / radius
             dt = 1.0 / (n_load * refine)
-            out.write(f"*STEP, INC=1000\n*STATIC\n{dt}, 1., {dt * 1e-4}, {dt}\n")
+            out.write("*STEP, INC=1000\n" + _static(dt, 1.0, dt * 1e-4, dt))
             out.write(f"*BOUNDARY, OP=NEW\nLBOT, 1, 2\n{ref}, 1, 1, 0.\n"
                       f"{ref}, 2, 2, {_fmt(lift)}\n*CLOAD, OP=NEW\n{ref}, 2, 0.\n")
             _outputs(out, plastic, fine_stress, frd, "TLOAD", stress_sets)
             out.write("*END STEP\n")
     elif case.delta > 0:
         dt = 4.0 / (n * refine)
-        out.write(f"*STEP, INC=10000\n*STATIC\n{dt}, {total}, {dt * 1e-4}, {dt}\n")
+        out.write("*STEP, INC=10000\n" + _static(dt, total, dt * 1e-4, dt))
         _change_friction(out, mesh, lower, upper, contact, loading=False)
         out.write(f"*BOUNDARY, AMPLITUDE=STROKE\n{ref}, 1, 1, {_fmt(case.delta)}\n" + controls)
         _outputs(out, plastic, fine_stress, frd, "TCYCLE", stress_sets)

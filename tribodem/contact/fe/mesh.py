@@ -20,6 +20,7 @@ Node and element numbers are 1-based in the sets below (the ccx convention); ``n
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -263,6 +264,68 @@ def morph_columns(mesh: Mesh, body: str, wear: NDArray[np.float64]) -> Mesh:
                info=dict(mesh.info), columns=mesh.columns, fine_layers=mesh.fine_layers)
     out.check()
     return out
+
+
+def _hat_samples(x: NDArray[np.float64], lo: float, hi: float, step: float
+                 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Sample points on the sorted node line ``x`` (midpoints of equal sub-intervals of each
+    element, at most ``step`` m wide where the element meets ``[lo, hi]``, one elsewhere)
+    and the weight of each sample for each node, [n_nodes, n_samples]: the node's linear
+    shape function times the sub-interval's length (a row sums to the node's tributary
+    length)."""
+    width = np.diff(x)
+    meets = (x[1:] >= lo) & (x[:-1] <= hi)
+    m = np.where(meets, np.maximum(np.ceil(width / step), 1.0), 1.0).astype(np.int64)
+    first = np.concatenate([[0], np.cumsum(m)[:-1]])
+    k = np.repeat(np.arange(width.size), m)  # the element of each sample
+    t = (np.arange(k.size) - first[k] + 0.5) / m[k]
+    dl = width[k] / m[k]
+    weights = np.zeros((x.size, k.size))
+    cols = np.arange(k.size)
+    weights[k, cols] = (1.0 - t) * dl
+    weights[k + 1, cols] = t * dl
+    return x[k] + t * width[k], weights
+
+
+Surface = Callable[[NDArray[np.float64], NDArray[np.float64]], NDArray[np.float64]]
+
+
+def worn_depth(now: Surface, base: Surface) -> Surface:
+    """(x, y) -> the recession ``now`` minus the unworn ``base`` clipped at zero, m: the
+    worn depth (a pile-up is not negative wear)."""
+    def depth(x: NDArray[np.float64], y: NDArray[np.float64]) -> NDArray[np.float64]:
+        return np.maximum(np.asarray(now(x, y), dtype=float)
+                          - np.asarray(base(x, y), dtype=float), 0.0)
+    return depth
+
+
+def surface_projection(depth: Surface, xs: NDArray[np.float64], ys: NDArray[np.float64] | None,
+                       box: tuple[float, float, float, float], step: float
+                       ) -> NDArray[np.float64]:
+    """Nodal values of ``depth(x, y)`` (m) on the grid ``xs`` x ``ys`` ([ny, nx]; ``ys`` None:
+    a line of nodes along ``xs`` at y = 0, [nx]) by the lumped L2 projection onto the
+    surface's bilinear (linear) shape functions: w_i = int phi_i depth dA / int phi_i dA, by
+    the midpoint rule on sub-cells at most ``step`` m wide inside ``box`` = (x_lo, x_hi,
+    y_lo, y_hi), m (``depth`` is zero outside it).
+
+    Node-column morphing (eqs 3.7-3.8) with these depths removes exactly the sampled volume
+    (the shape functions sum to one, and the morphed surface's volume is the sum of nodal
+    depths times int phi_i dA, the tributary areas), and features shorter than the
+    elements are filtered out (a wave of two elements' length keeps 0.4 of its amplitude):
+    sampled at the nodes alone a scar a few elements wide lost the wrong volume (+-50 % on
+    a 44-um mesh) and its rim became kinks the sliding contact catches on."""
+    x_lo, x_hi, y_lo, y_hi = box
+    px, wx = _hat_samples(np.asarray(xs, dtype=float), x_lo, x_hi, step)
+    if ys is None:
+        py, wy = np.zeros(1), np.ones((1, 1))
+    else:
+        py, wy = _hat_samples(np.asarray(ys, dtype=float), y_lo, y_hi, step)
+    x, y = np.meshgrid(px, py)
+    inside = (x >= x_lo) & (x <= x_hi) & (y >= y_lo) & (y <= y_hi)
+    w = np.zeros_like(x)
+    w[inside] = np.asarray(depth(x[inside], y[inside]), dtype=float)
+    out = (wy @ w @ wx.T) / np.outer(wy.sum(axis=1), wx.sum(axis=1))
+    return out[0] if ys is None else out
 
 
 def worn_area(original: Mesh, morphed: Mesh, body: str) -> float:
