@@ -138,6 +138,45 @@ def test_surface_projection_is_volume_true() -> None:
     assert np.abs(wave[5:-5]).max() == pytest.approx(4.0 / np.pi**2, rel=1e-3)
 
 
+def test_retries_halve_the_increments_then_the_penalty(tmp_path: Path,
+                                                      monkeypatch: pytest.MonkeyPatch) -> None:
+    """A job that does not converge is retried at half the increments, then also with the
+    contact's penalty stiffnesses halved (``attempt_settings``), each deck named for it; the
+    last failure is raised (ccx replaced by a stand-in that converges only on a soft deck)."""
+    from types import SimpleNamespace
+
+    from tribodem.contact.fe import jobs
+    from tribodem.contact.fe.ccx import CcxConvergenceError
+
+    assert [jobs.attempt_settings(a) for a in range(5)] == [
+        (1, 1.0), (2, 1.0), (2, 0.5), (4, 0.5), (4, 0.25)]
+    ran: list[str] = []
+
+    def stand_in(deck: Path, **kw: object) -> SimpleNamespace:
+        ran.append(deck.name)
+        if "soft" not in deck.name:
+            raise CcxConvergenceError("ccx did not converge", "*ERROR: too many cutbacks", deck)
+        return SimpleNamespace(job=deck.with_suffix(""), cached=False)
+
+    monkeypatch.setattr(jobs, "run_ccx", stand_in)
+    written: list[tuple[str, int, float]] = []
+
+    def write(refine: int, name: str, scale: float) -> Path:
+        written.append((name, refine, scale))
+        deck = tmp_path / f"{name}.inp"
+        deck.write_text(f"{refine} {scale}\n")
+        return deck
+
+    run, refine, scale, _, _ = jobs.run_job(write, 2, 1, 60.0, None)
+    assert written == [("job", 1, 1.0), ("job_refine2", 2, 1.0), ("job_refine2_soft2", 2, 0.5)]
+    assert ran == ["job.inp", "job_refine2.inp", "job_refine2_soft2.inp"]
+    assert (refine, scale, run.job.name) == (2, 0.5, "job_refine2_soft2")
+    written.clear()
+    with pytest.raises(CcxConvergenceError):
+        jobs.run_job(write, 1, 1, 60.0, None)
+    assert [w[0] for w in written] == ["job", "job_refine2"]
+
+
 def test_cell_average_conserves_the_integral() -> None:
     xn = np.array([-2.0, -1.0, 0.0, 0.5, 1.0, 3.0])
     vn = np.array([0.0, 1.0, 3.0, 2.0, 1.0, 0.0])

@@ -106,7 +106,9 @@ def test_deck_fields_fit_ccx(tmp_path: Path) -> None:
     """ccx reads each data field as at most 20 characters: a minimum increment written as
     ``8.333333333333334e-06`` (48 increments a cycle) was read as 8.3 and ccx stopped ("a
     time point precedes the minimum time tmin"). Every field of the deck fits, and every
-    ``*STATIC`` starts within its step with a minimum below the initial increment."""
+    ``*STATIC`` starts within its step with a minimum below the initial increment. A
+    retry's softer contact (``penalty_scale`` 1/2) halves the normal penalty and the stick
+    slope and nothing else of them (mu, the tension)."""
     for n_inc, material in ((48, "elastic"), (12, "elastic-plastic"), (16, "elastic")):
         solver = _solver(tmp_path, n_increments=n_inc, material=material)
         deck = solver.write_deck(tmp_path / f"job{n_inc}.inp", solver._mesh0, 1e-6)
@@ -116,6 +118,19 @@ def test_deck_fields_fit_ccx(tmp_path: Path) -> None:
         long = [f for line in data for f in line.split(",") if len(f.strip()) > 20]
         assert not long
         static = [lines[k + 1] for k, line in enumerate(lines) if line == "*STATIC"]
+        soft = solver.write_deck(tmp_path / "soft.inp", solver._mesh0, 1e-6,
+                                 penalty_scale=0.5).read_text().splitlines()
+        for key in ("*SURFACE BEHAVIOR", "*FRICTION"):  # a retry's softer contact: k / 2
+            rows = [(lines[k + 1], soft[k + 1]) for k, line in enumerate(lines)
+                    if line.startswith(key)]
+            assert rows
+            for hard, half in rows:
+                assert float(half.split(",")[1]) == pytest.approx(
+                    0.5 * float(hard.split(",")[1]) if key == "*FRICTION" else
+                    float(hard.split(",")[1]), rel=1e-9)
+                assert float(half.split(",")[0]) == pytest.approx(
+                    float(hard.split(",")[0]) if key == "*FRICTION" else
+                    0.5 * float(hard.split(",")[0]), rel=1e-9)
         assert len(static) >= 6
         for row in static:
             initial, period, minimum, maximum = (float(v) for v in row.split(","))

@@ -152,7 +152,8 @@ class FEContactSolver(CcxJobs, FirstBodySolver):
     ``size_factor`` (bodies' size / a) of the mesh (defaults from the convergence study in
     docs/fe.md); ``stress_depth`` (m): how deep the column stresses are printed (None: 4 a
     and 1.5 x the threshold criteria's default depth); ``threads``, ``timeout`` (s per ccx
-    job), ``retries`` (after a non-convergence, each retry halves the largest increment);
+    job), ``retries`` (after a non-convergence: :func:`.jobs.attempt_settings`, halved
+    increments, then a softer contact);
     ``workdir``: the folder of the jobs (``cycle_0001/`` ...; None: a new temporary
     folder). ``regime`` and ``tolerance``
     are the half-space's options and are not used (the FE interface always has partial slip
@@ -224,7 +225,7 @@ class FEContactSolver(CcxJobs, FirstBodySolver):
         size_factor: float = 40.0,
         threads: int = 1,
         timeout: float = 900.0,
-        retries: int = 1,
+        retries: int = 2,
         cache: str | Path | None = None,
         workdir: str | Path | None = None,
         executable: str | None = None,
@@ -319,6 +320,7 @@ class FEContactSolver(CcxJobs, FirstBodySolver):
                              if stress_depth is not None else
                              max(4.0 * a, 4.5 * math.sqrt(2.0 * a * self.window / math.pi)))
         self.settings = sliding_contact(self.friction, self.hertz[0])
+        self._job_settings = self.settings
         self.jobs: list[JobRecord] = []  #: every ccx job run, in order
         self._mesh0 = self._base_mesh()
         self._job_key: tuple[bytes, bytes] | None = None
@@ -479,24 +481,27 @@ class FEContactSolver(CcxJobs, FirstBodySolver):
         t_mesh = time.perf_counter() - t0
         base = math.ceil(self.plastic_increments / self.n_increments) if self.plastic else 1
 
-        def write(refine: int, name: str) -> Path:
+        def write(refine: int, name: str, scale: float) -> Path:
             case = LoadCase(load=self.load_per_length, delta=self.amplitude,
                             n_increments=self.n_increments, seat=seat, refine=refine,
                             cycle_refine=base,
                             split_cycle=True, cycles=int(cycles), unload=self.plastic,
                             load_increments=PLASTIC_LOAD_INCREMENTS if self.plastic else 5)
-            return write_deck(folder / f"{name}.inp", mesh, case, lower, upper, self.settings,
-                              fine_stress=False, stress_sets=("LCOL", "UCOL"))
+            return write_deck(folder / f"{name}.inp", mesh, case, lower, upper,
+                              self._scaled_settings(scale), fine_stress=False,
+                              stress_sets=("LCOL", "UCOL"))
 
-        run, refine, t_deck, t_ccx = run_job(write, self.retries, self.threads, self.timeout,
-                                             self.executable, self.cache)
+        run, refine, scale, t_deck, t_ccx = run_job(write, self.retries, self.threads,
+                                                    self.timeout, self.executable, self.cache)
+        self._job_settings = self._scaled_settings(scale)
         t_mesh += t_deck
         t3 = time.perf_counter()
         res = read_results(run.job, mesh)
         t_read = time.perf_counter() - t3
         rec = JobRecord(cycle=self._cycle + 1, folder=folder, deck=run.job.with_suffix(".inp"),
                         cached=run.cached,
-                        elements=mesh.n_elements, refine=refine * base, seconds_mesh=t_mesh,
+                        elements=mesh.n_elements, refine=refine * base, penalty_scale=scale,
+                        seconds_mesh=t_mesh,
                         seconds_ccx=t_ccx, seconds_read=t_read, cycles=int(cycles),
                         worn_volume_upper=self.worn_volume("upper", mesh),
                         worn_volume_lower=self.worn_volume("lower", mesh))
@@ -577,7 +582,8 @@ class FEContactSolver(CcxJobs, FirstBodySolver):
             stick = None
             direction = 0.0
         else:
-            k_t = self.settings.stick_factor * self.settings.penalty_factor * min(
+            s = self._job_settings  # the contact of the attempt that converged
+            k_t = s.stick_factor * s.penalty_factor * min(
                 self.upper_material.young, self.lower_material.young) / self.mesh.h_fine
             u_up0 = self._displacement("UBOT", ubot, prev_t)
             u_up1 = self._displacement("UBOT", ubot, t)

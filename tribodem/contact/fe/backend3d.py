@@ -272,7 +272,8 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
     radius a), ``size_factor`` (bodies' extent / a, at most R / (2 a)) and ``growth`` of the
     mesh; ``stress_depth`` (m): how deep the column stresses are printed (None: 4.5 a, 1.5 x
     the threshold criteria's default grid depth 3 a); ``threads``, ``timeout`` (s per ccx
-    job), ``retries`` (after a non-convergence each retry halves the largest increment);
+    job), ``retries`` (after a non-convergence: :func:`.jobs.attempt_settings`, halved
+    increments, then a softer contact);
     ``workdir``: the jobs' folder (``cycle_0001/`` ...; None: a new temporary folder).
     ``regime`` and ``tolerance`` are the half-space's options and are not used, nor is
     ``chain_cycles`` (mode ``chained`` of the 2D backend); ``material`` must be
@@ -329,7 +330,7 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         growth: float = FRETTING3D_GROWTH,
         threads: int = 1,
         timeout: float = 1800.0,
-        retries: int = 1,
+        retries: int = 2,
         cache: str | Path | None = None,
         workdir: str | Path | None = None,
         executable: str | None = None,
@@ -421,6 +422,7 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         #: flip for ever at h = a/2: measured, docs/fe3d.md), stick slope 0.1 x the penalty
         self.settings: ContactSettings = sliding_contact(self.friction, hz.peak_pressure,
                                                          penalty_factor=PENALTY_FACTOR)
+        self._job_settings = self.settings  #: the contact of the last job's attempt
         self.jobs: list[JobRecord] = []  #: every ccx job run, in order
         self._mesh0 = self._base_mesh()
         self._cols = mesh_columns(self._mesh0)
@@ -580,14 +582,15 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         return min(1.5 * self.hertz[1], self.stress_depth)
 
     # -- the deck ---------------------------------------------------------------------------
-    def write_deck(self, path: str | Path, mesh: Mesh3D, seat: float, refine: int = 1) -> Path:
+    def write_deck(self, path: str | Path, mesh: Mesh3D, seat: float, refine: int = 1,
+                   penalty_scale: float = 1.0) -> Path:
         """The ccx deck: half model, node-to-surface pair once, seating (REF down by ``seat``
         m, friction 0.001), the load P / 2 on REF (automatic increments <= 1/4), the cycle as
         one step per quarter (REF x ramped to +A, 0, -A, 0, increments <= 4 / n_increments,
         divided by ``refine``), outputs at the loop's offsets: the support's total reaction,
         REF, both contact faces' displacements, the Gauss-point stresses of the upper contact
         layer (``UCONT``, the tractions) and of the column sets ``UCOL``/``LCOL``."""
-        s = self.settings
+        s = self._scaled_settings(penalty_scale)
         lo_m, up_m = self._materials()
         out = io.StringIO()
         out.write("*HEADING\ntribodem fe3d: crossed cylinders, half model (y >= 0)\n")
@@ -811,9 +814,11 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         mesh = self.morphed_mesh()
         seat = self._seat(mesh)
         t_mesh = time.perf_counter() - t0
-        run, refine, t_deck, t_ccx = run_job(
-            lambda refine, name: self.write_deck(folder / f"{name}.inp", mesh, seat, refine),
+        run, refine, scale, t_deck, t_ccx = run_job(
+            lambda refine, name, scale: self.write_deck(folder / f"{name}.inp", mesh, seat,
+                                                        refine, scale),
             self.retries, self.threads, self.timeout, self.executable, self.cache)
+        self._job_settings = self._scaled_settings(scale)
         t_mesh += t_deck
         t3 = time.perf_counter()
         blocks = read_dat(run.dat)
@@ -821,6 +826,7 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         t_read = time.perf_counter() - t3
         rec = JobRecord(cycle=self._cycle + 1, folder=folder, deck=run.job.with_suffix(".inp"),
                         cached=run.cached, elements=int(mesh.elements.shape[0]), refine=refine,
+                        penalty_scale=scale,
                         seconds_mesh=t_mesh, seconds_ccx=t_ccx, seconds_read=t_read,
                         worn_volume_upper=self.worn_volume("upper", mesh),
                         worn_volume_lower=self.worn_volume("lower", mesh))
@@ -903,7 +909,8 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
             states = [states[0], *states[2:]]
         n, cell = self.n, self.dx * self.dx
         xs, xl, ys_full = self._xs, self._xl, self._ys_full
-        k_t = self.settings.stick_factor * self.settings.penalty_factor * min(
+        s = self._job_settings  # the contact of the attempt that converged
+        k_t = s.stick_factor * s.penalty_factor * min(
             self.upper_material.young, self.lower_material.young) / self.mesh.h_fine
         out: list[IncrementResult] = []
         xg, yg = np.meshgrid(xs, self._ys)  # [ny, nx] undeformed upper surface nodes

@@ -15,7 +15,7 @@ import shutil
 import tempfile
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -30,7 +30,7 @@ from tribodem.contact.fe.ccx import (
     resolve_ccx,
     run_ccx,
 )
-from tribodem.contact.fe.deck import FEMaterial
+from tribodem.contact.fe.deck import ContactSettings, FEMaterial
 from tribodem.io.results import write_csv
 
 
@@ -51,11 +51,12 @@ class JobRecord:
     worn_volume_upper: float = 0.0  #: worn volume of the morphed upper body, m^3
     worn_volume_lower: float = 0.0  #: worn volume of the morphed lower body, m^3
     cached: bool = False  #: ccx's results came from the job cache (not run again)
+    penalty_scale: float = 1.0  #: contact penalty scale of the successful attempt
 
 
-JOB_COLUMNS = ("cycle", "cycles", "elements", "refine", "seconds_mesh", "seconds_ccx",
-               "seconds_read", "seconds_map", "worn_volume_upper_m3", "worn_volume_lower_m3",
-               "cached", "deck")
+JOB_COLUMNS = ("cycle", "cycles", "elements", "refine", "penalty_scale", "seconds_mesh",
+               "seconds_ccx", "seconds_read", "seconds_map", "worn_volume_upper_m3",
+               "worn_volume_lower_m3", "cached", "deck")
 
 
 #: materials of the ccx backends: elastic, or bilinear elastic-plastic (``*PLASTIC``)
@@ -104,28 +105,41 @@ def _to_cache(run: CcxRun, cache: Path, key: str) -> None:
         shutil.rmtree(tmp, ignore_errors=True)
 
 
-def run_job(write: Callable[[int, str], Path], retries: int, threads: int, timeout: float,
-            executable: str | None, cache: Path | None = None
-            ) -> tuple[CcxRun, int, float, float]:
-    """Write and run one ccx job, retrying a non-converging one with increments refined
-    2, 4, ... times (``retries`` more attempts; the last failure is raised).
+def attempt_settings(attempt: int) -> tuple[int, float]:
+    """(increment refinement, contact penalty scale) of ``run_job``'s attempt ``attempt`` (0:
+    the job as configured): the retries halve the increments and the contact's penalty
+    stiffnesses (normal and stick slope together) in turn: (1, 1), (2, 1), (2, 1/2), (4,
+    1/2), (4, 1/4). The softer contact is for the stick / slip state of a node on a worn
+    rim that flips every Newton iteration whatever the increment (docs/fe3d.md)."""
+    return 2 ** ((attempt + 1) // 2), 0.5 ** (attempt // 2)
 
-    ``write(refine, name)`` writes the deck ``name`` (``job``, ``job_refine2``, ...) at that
-    refinement and returns its path. ``cache``: a folder of finished jobs keyed by the deck's
-    bytes and the ccx build; a deck found there is not run again, its outputs are copied
-    into the job folder (``CcxRun.cached``). Returns (the run, its refinement, seconds
-    writing decks, seconds in ccx over all attempts)."""
+
+def run_job(write: Callable[[int, str, float], Path], retries: int, threads: int,
+            timeout: float, executable: str | None, cache: Path | None = None
+            ) -> tuple[CcxRun, int, float, float, float]:
+    """Write and run one ccx job, retrying a non-converging one (``retries`` more attempts,
+    :func:`attempt_settings`; the last failure is raised).
+
+    ``write(refine, name, penalty_scale)`` writes the deck ``name`` (``job``,
+    ``job_refine2``, ``job_refine2_soft2``, ...) at that refinement and contact penalty scale
+    and returns its path. ``cache``: a folder of finished jobs keyed by the deck's bytes and
+    the ccx build; a deck found there is not run again, its outputs are copied into the job
+    folder (``CcxRun.cached``). Returns (the run, its refinement, its penalty scale,
+    seconds writing decks, seconds in ccx over all attempts)."""
     t_deck = t_ccx = 0.0
     for attempt in range(retries + 1):
-        refine = 2**attempt
+        refine, scale = attempt_settings(attempt)
+        name = "job" if attempt == 0 else f"job_refine{refine}"
+        if scale != 1.0:
+            name += f"_soft{round(1.0 / scale)}"
         t1 = time.perf_counter()
-        deck = write(refine, "job" if attempt == 0 else f"job_refine{refine}")
+        deck = write(refine, name, scale)
         t_deck += time.perf_counter() - t1
         if cache is not None:
             key = _cache_key(deck, executable)
             hit = _from_cache(deck, cache, key)
             if hit is not None:
-                return hit, refine, t_deck, t_ccx
+                return hit, refine, scale, t_deck, t_ccx
         t2 = time.perf_counter()
         try:
             run = run_ccx(deck, threads=threads, timeout=timeout, executable=executable)
@@ -137,7 +151,7 @@ def run_job(write: Callable[[int, str], Path], retries: int, threads: int, timeo
         t_ccx += time.perf_counter() - t2
         if cache is not None:
             _to_cache(run, cache, key)
-        return run, refine, t_deck, t_ccx
+        return run, refine, scale, t_deck, t_ccx
     raise AssertionError("unreachable")  # pragma: no cover
 
 
@@ -174,6 +188,15 @@ class CcxJobs:
     dx: float
     n: int
     _pending: list[PlasticStep]
+    settings: ContactSettings  #: the interface law as configured
+    #: the interface law of the last job's converged attempt (:func:`attempt_settings`)
+    _job_settings: ContactSettings
+
+    def _scaled_settings(self, scale: float) -> ContactSettings:
+        """``settings`` with the penalty stiffnesses (normal, and the stick slope with it)
+        scaled by ``scale`` (a retry's softer contact)."""
+        s = self.settings
+        return s if scale == 1.0 else replace(s, penalty_factor=s.penalty_factor * scale)
 
     def _set_material(self, material: str, plastic_increments: int, yield_strength: float,
                       uts: float, uts_strain: float, hardening: float | None) -> None:
@@ -300,7 +323,8 @@ class CcxJobs:
                     rows = list(csv.reader(fh))
                 if rows and tuple(rows[0]) == JOB_COLUMNS:
                     self._prior_jobs = rows[1:]
-        rows = [[rec.cycle, rec.cycles, rec.elements, rec.refine, f"{rec.seconds_mesh:.4f}",
+        rows = [[rec.cycle, rec.cycles, rec.elements, rec.refine, f"{rec.penalty_scale:g}",
+                 f"{rec.seconds_mesh:.4f}",
                  f"{rec.seconds_ccx:.3f}", f"{rec.seconds_read:.4f}", f"{rec.seconds_map:.4f}",
                  f"{rec.worn_volume_upper:.9e}", f"{rec.worn_volume_lower:.9e}",
                  int(rec.cached), str(rec.deck)]
