@@ -318,9 +318,9 @@ class FEConfig(_Model):
                                "most R / (2 a))")
     threads: int = Field(1, ge=0, description="ccx threads (0 = all cores; --threads)")
     timeout: float = Field(1800.0, gt=0, description="wall-clock limit of one ccx job, s")
-    retries: int = Field(2, ge=0, le=4, description="retries after a non-convergence: "
+    retries: int = Field(1, ge=0, le=4, description="retries after a non-convergence: "
                          "halved increments, then also a contact half as stiff, alternately "
-                         "(jobs.attempt_settings)")
+                         "(jobs.attempt_settings; 1: halved increments only)")
     cache: str | None = Field(None, description="folder of finished ccx jobs keyed by the "
                               "deck's bytes and the ccx build: a deck found there is not run "
                               "again (the chapter 6 study shares one across its stages)")

@@ -225,7 +225,7 @@ class FEContactSolver(CcxJobs, FirstBodySolver):
         size_factor: float = 40.0,
         threads: int = 1,
         timeout: float = 900.0,
-        retries: int = 2,
+        retries: int = 1,
         cache: str | Path | None = None,
         workdir: str | Path | None = None,
         executable: str | None = None,

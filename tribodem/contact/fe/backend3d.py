@@ -330,7 +330,7 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         growth: float = FRETTING3D_GROWTH,
         threads: int = 1,
         timeout: float = 1800.0,
-        retries: int = 2,
+        retries: int = 1,
         cache: str | Path | None = None,
         workdir: str | Path | None = None,
         executable: str | None = None,
