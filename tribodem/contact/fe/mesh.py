@@ -20,12 +20,13 @@ Node and element numbers are 1-based in the sets below (the ccx convention); ``n
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 from numpy.typing import NDArray
+
+from tribodem.contact.base import Recession
 
 #: ccx face label of each quadrilateral edge (nodes 1-2, 2-3, 3-4, 4-1 counter-clockwise)
 FACES = ("S1", "S2", "S3", "S4")
@@ -287,10 +288,7 @@ def _hat_samples(x: NDArray[np.float64], lo: float, hi: float, step: float
     return x[k] + t * width[k], weights
 
 
-Surface = Callable[[NDArray[np.float64], NDArray[np.float64]], NDArray[np.float64]]
-
-
-def worn_depth(now: Surface, base: Surface) -> Surface:
+def worn_depth(now: Recession, base: Recession) -> Recession:
     """(x, y) -> the recession ``now`` minus the unworn ``base`` clipped at zero, m: the
     worn depth (a pile-up is not negative wear)."""
     def depth(x: NDArray[np.float64], y: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -299,7 +297,7 @@ def worn_depth(now: Surface, base: Surface) -> Surface:
     return depth
 
 
-def surface_projection(depth: Surface, xs: NDArray[np.float64], ys: NDArray[np.float64] | None,
+def surface_projection(depth: Recession, xs: NDArray[np.float64], ys: NDArray[np.float64] | None,
                        box: tuple[float, float, float, float], step: float
                        ) -> NDArray[np.float64]:
     """Nodal values of ``depth(x, y)`` (m) on the grid ``xs`` x ``ys`` ([ny, nx]; ``ys`` None:
@@ -311,7 +309,7 @@ def surface_projection(depth: Surface, xs: NDArray[np.float64], ys: NDArray[np.f
     Node-column morphing (eqs 3.7-3.8) with these depths removes exactly the sampled volume
     (the shape functions sum to one, and the morphed surface's volume is the sum of nodal
     depths times int phi_i dA, the tributary areas), and features shorter than the
-    elements are filtered out (a wave of two elements' length keeps 0.4 of its amplitude):
+    elements are damped (a wave two elements long keeps 4 / pi^2 = 0.4 of its amplitude):
     sampled at the nodes alone a scar a few elements wide lost the wrong volume (+-50 % on
     a 44-um mesh) and its rim became kinks the sliding contact catches on."""
     x_lo, x_hi, y_lo, y_hi = box
