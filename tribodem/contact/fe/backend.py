@@ -320,7 +320,6 @@ class FEContactSolver(CcxJobs, FirstBodySolver):
                              if stress_depth is not None else
                              max(4.0 * a, 4.5 * math.sqrt(2.0 * a * self.window / math.pi)))
         self.settings = sliding_contact(self.friction, self.hertz[0])
-        self._job_settings = self.settings
         self.jobs: list[JobRecord] = []  #: every ccx job run, in order
         self._mesh0 = self._base_mesh()
         self._job_key: tuple[bytes, bytes] | None = None
@@ -493,7 +492,7 @@ class FEContactSolver(CcxJobs, FirstBodySolver):
 
         run, refine, scale, t_deck, t_ccx = run_job(write, self.retries, self.threads,
                                                     self.timeout, self.executable, self.cache)
-        self._job_settings = self._scaled_settings(scale)
+        self._penalty_scale = scale
         t_mesh += t_deck
         t3 = time.perf_counter()
         res = read_results(run.job, mesh)
@@ -582,9 +581,7 @@ class FEContactSolver(CcxJobs, FirstBodySolver):
             stick = None
             direction = 0.0
         else:
-            s = self._job_settings  # the contact of the attempt that converged
-            k_t = s.stick_factor * s.penalty_factor * min(
-                self.upper_material.young, self.lower_material.young) / self.mesh.h_fine
+            k_t = self._stick_slope()
             u_up0 = self._displacement("UBOT", ubot, prev_t)
             u_up1 = self._displacement("UBOT", ubot, t)
             u_lo0 = self._displacement("LTOP", ltop, prev_t)

@@ -422,7 +422,6 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         #: flip for ever at h = a/2: measured, docs/fe3d.md), stick slope 0.1 x the penalty
         self.settings: ContactSettings = sliding_contact(self.friction, hz.peak_pressure,
                                                          penalty_factor=PENALTY_FACTOR)
-        self._job_settings = self.settings  #: the contact of the last job's attempt
         self.jobs: list[JobRecord] = []  #: every ccx job run, in order
         self._mesh0 = self._base_mesh()
         self._cols = mesh_columns(self._mesh0)
@@ -818,7 +817,7 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
             lambda refine, name, scale: self.write_deck(folder / f"{name}.inp", mesh, seat,
                                                         refine, scale),
             self.retries, self.threads, self.timeout, self.executable, self.cache)
-        self._job_settings = self._scaled_settings(scale)
+        self._penalty_scale = scale
         t_mesh += t_deck
         t3 = time.perf_counter()
         blocks = read_dat(run.dat)
@@ -909,9 +908,7 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
             states = [states[0], *states[2:]]
         n, cell = self.n, self.dx * self.dx
         xs, xl, ys_full = self._xs, self._xl, self._ys_full
-        s = self._job_settings  # the contact of the attempt that converged
-        k_t = s.stick_factor * s.penalty_factor * min(
-            self.upper_material.young, self.lower_material.young) / self.mesh.h_fine
+        k_t = self._stick_slope()
         out: list[IncrementResult] = []
         xg, yg = np.meshgrid(xs, self._ys)  # [ny, nx] undeformed upper surface nodes
         prev: dict[str, Any] | None = None

@@ -17,6 +17,7 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -189,14 +190,23 @@ class CcxJobs:
     n: int
     _pending: list[PlasticStep]
     settings: ContactSettings  #: the interface law as configured
-    #: the interface law of the last job's converged attempt (:func:`attempt_settings`)
-    _job_settings: ContactSettings
+    mesh: Any  #: the (morphed) mesh of the last job (``h_fine``, m)
+    #: the contact penalty scale of the last job's converged attempt (:func:`attempt_settings`)
+    _penalty_scale: float = 1.0
 
     def _scaled_settings(self, scale: float) -> ContactSettings:
         """``settings`` with the penalty stiffnesses (normal, and the stick slope with it)
         scaled by ``scale`` (a retry's softer contact)."""
         s = self.settings
         return s if scale == 1.0 else replace(s, penalty_factor=s.penalty_factor * scale)
+
+    def _stick_slope(self) -> float:
+        """The last job's stick slope k_t, Pa/m: stick factor x penalty factor x E_min / h
+        of the contact its converged attempt ran with (a slip increment up to mu p / k_t is
+        the interface spring's, i.e. stick)."""
+        s = self._scaled_settings(self._penalty_scale)
+        return s.stick_factor * s.penalty_factor * min(
+            self.upper_material.young, self.lower_material.young) / self.mesh.h_fine
 
     def _set_material(self, material: str, plastic_increments: int, yield_strength: float,
                       uts: float, uts_strain: float, hardening: float | None) -> None:
