@@ -622,7 +622,7 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
             if int(nid) != ref:
                 for d in (1, 3):
                     out.write(f"2\n{int(nid)}, {d}, 1., {ref}, {d}, -1.\n")
-        k_n = s.penalty_factor * min(lo_m.young, up_m.young) / mesh.h_fine
+        k_n = s.normal_penalty(lo_m.young, up_m.young, mesh.h_fine)
         tension = "" if s.tension is None else f", {_fmt(s.tension)}"
         out.write("*SURFACE INTERACTION, NAME=SI\n")
         out.write(f"*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR\n{_fmt(k_n)}{tension}\n")

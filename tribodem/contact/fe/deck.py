@@ -99,6 +99,20 @@ class ContactSettings:
     #: (None: ccx's default, measured 0.34 % of p0 on every free slave node; docs/fe.md)
     tension: float | None = None
 
+    def normal_penalty(self, young_a: float, young_b: float, h: float) -> float:
+        """Normal penalty stiffness k_n = ``penalty_factor`` x min(E_a, E_b) / h, Pa/m (E in
+        Pa, h the fine element size in m): what every deck writes and every reading of
+        stick and slip assumes."""
+        return self.penalty_factor * min(young_a, young_b) / h
+
+    def stick_slope(self, young_a: float, young_b: float, h: float,
+                    loading: bool = False) -> float:
+        """Stick slope k_t = stick factor x k_n, Pa/m (``stick_factor_loading`` while
+        seating and loading): a slip increment up to mu p / k_t is the interface spring's,
+        i.e. stick."""
+        factor = self.stick_factor_loading if loading else self.stick_factor
+        return factor * self.normal_penalty(young_a, young_b, h)
+
 
 #: normal penalty of the sliding set-up, x E_min / h (docs/fe.md, "Penalty and speed": at
 #: 10 E/h ccx slides a quarter cycle of +-0.1 mm in 9 increments where 50 E/h took 67, 3.2x
@@ -196,12 +210,13 @@ def _model_data(out: io.StringIO, mesh: Mesh, lower: FEMaterial, upper: FEMateri
         if int(n) != ref:
             for dof in (1, 2):
                 out.write(f"2\n{int(n)}, {dof}, 1., {ref}, {dof}, -1.\n")
-    k_n = contact.penalty_factor * min(lower.young, upper.young) / mesh.h_fine
+    k_n = contact.normal_penalty(lower.young, upper.young, mesh.h_fine)
     out.write("*SURFACE INTERACTION, NAME=SI\n")
     tension = "" if contact.tension is None else f", {_fmt(contact.tension)}"
     out.write(f"*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR\n{_fmt(k_n)}{tension}\n")
     if contact.mu > 0:
-        out.write(f"*FRICTION\n{contact.mu}, {_fmt(contact.stick_factor * k_n)}\n")
+        k_t = contact.stick_slope(lower.young, upper.young, mesh.h_fine)
+        out.write(f"*FRICTION\n{contact.mu}, {_fmt(k_t)}\n")
     if contact.pair_in_model:
         out.write(f"*CONTACT PAIR, INTERACTION=SI, TYPE={contact.formulation}\nSPAD, SFLAT\n")
 
@@ -209,11 +224,10 @@ def _model_data(out: io.StringIO, mesh: Mesh, lower: FEMaterial, upper: FEMateri
 def _change_friction(out: io.StringIO, mesh: Mesh, lower: FEMaterial, upper: FEMaterial,
                      contact: ContactSettings, loading: bool) -> None:
     if contact.mu > 0:
-        k_n = contact.penalty_factor * min(lower.young, upper.young) / mesh.h_fine
         mu = contact.mu_loading if loading else contact.mu
-        factor = contact.stick_factor_loading if loading else contact.stick_factor
+        k_t = contact.stick_slope(lower.young, upper.young, mesh.h_fine, loading)
         out.write("*CHANGE FRICTION, INTERACTION=SI\n")
-        out.write(f"*FRICTION\n{mu}, {_fmt(factor * k_n)}\n")
+        out.write(f"*FRICTION\n{mu}, {_fmt(k_t)}\n")
     if not contact.pair_in_model:
         out.write(f"*CONTACT PAIR, INTERACTION=SI, TYPE={contact.formulation}\nSPAD, SFLAT\n")
 

@@ -204,9 +204,8 @@ class CcxJobs:
         """The last job's stick slope k_t, Pa/m: stick factor x penalty factor x E_min / h
         of the contact its converged attempt ran with (a slip increment up to mu p / k_t is
         the interface spring's, i.e. stick)."""
-        s = self._scaled_settings(self._penalty_scale)
-        return s.stick_factor * s.penalty_factor * min(
-            self.upper_material.young, self.lower_material.young) / self.mesh.h_fine
+        return self._scaled_settings(self._penalty_scale).stick_slope(
+            self.upper_material.young, self.lower_material.young, self.mesh.h_fine)
 
     def _set_material(self, material: str, plastic_increments: int, yield_strength: float,
                       uts: float, uts_strain: float, hardening: float | None) -> None:

@@ -132,8 +132,7 @@ def tangential_checks(run: LineRun, ratios: tuple[float, ...] = (0.35, 0.55, 0.7
     out = [check("gross_slip_Q_over_muP", float(qs[-1] / mu_p), 1.0, 0.01)]
     # full-stick compliance of the model, from the first increment
     compliance = (ds[0] - slip_displacement(qs[0], mu_p, e_star)) / qs[0]
-    k_t = case.contact.stick_factor * case.contact.penalty_factor * min(
-        case.lower.young, case.upper.young) / run.mesh.h_fine
+    k_t = case.contact.stick_slope(case.lower.young, case.upper.young, run.mesh.h_fine)
     used: set[int] = set()
     for target in ratios:
         cand = [j for j in range(1, steps.size) if j not in used and qs[j] / mu_p < 0.95]
