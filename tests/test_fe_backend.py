@@ -138,6 +138,24 @@ def test_surface_projection_is_volume_true() -> None:
     assert np.abs(wave[5:-5]).max() == pytest.approx(4.0 / np.pi**2, rel=1e-3)
 
 
+def test_a_resumed_run_keeps_the_jobs_of_an_older_jobs_csv(tmp_path: Path) -> None:
+    """``prior_job_rows``: a ``jobs.csv`` written before the ``penalty_scale`` column
+    existed keeps its rows on resume (the column filled with 1, the scale those jobs ran
+    at); a file with a column this version does not know starts afresh."""
+    from tribodem.contact.fe import jobs
+
+    old = [c for c in jobs.JOB_COLUMNS if c != "penalty_scale"]
+    path = tmp_path / "jobs.csv"
+    path.write_text(",".join(old) + "\n" + ",".join(str(k) for k in range(len(old))) + "\n")
+    rows = jobs.prior_job_rows(path)
+    assert len(rows) == 1 and len(rows[0]) == len(jobs.JOB_COLUMNS)
+    got = dict(zip(jobs.JOB_COLUMNS, rows[0], strict=True))
+    assert got["penalty_scale"] == "1" and got["cycle"] == "0" and got["deck"] == "11"
+    path.write_text(",".join(jobs.JOB_COLUMNS + ("future",)) + "\n")
+    assert jobs.prior_job_rows(path) == []
+    assert jobs.prior_job_rows(tmp_path / "none.csv") == []
+
+
 def test_retries_halve_the_increments_then_the_penalty(tmp_path: Path,
                                                       monkeypatch: pytest.MonkeyPatch) -> None:
     """A job that does not converge is retried at half the increments, then also with the

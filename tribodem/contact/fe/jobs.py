@@ -55,9 +55,26 @@ class JobRecord:
     penalty_scale: float = 1.0  #: contact penalty scale of the successful attempt
 
 
+#: a column that an older ``jobs.csv`` lacks, and what its rows meant by leaving it out
+JOB_DEFAULTS = {"penalty_scale": "1"}
 JOB_COLUMNS = ("cycle", "cycles", "elements", "refine", "penalty_scale", "seconds_mesh",
                "seconds_ccx", "seconds_read", "seconds_map", "worn_volume_upper_m3",
                "worn_volume_lower_m3", "cached", "deck")
+
+
+def prior_job_rows(path: Path) -> list[list[str]]:
+    """The rows of an earlier session's ``jobs.csv`` in ``JOB_COLUMNS`` order (a file
+    written before a column existed gets ``JOB_DEFAULTS``); ``[]`` when there is no such
+    file or its header has a column this version does not know."""
+    if not path.exists():
+        return []
+    with open(path, newline="") as fh:
+        reader = csv.DictReader(fh)
+        fields = set(reader.fieldnames or ())
+        rows = list(reader)
+    if not fields or not fields <= set(JOB_COLUMNS):
+        return []
+    return [[row.get(c) or JOB_DEFAULTS.get(c, "") for c in JOB_COLUMNS] for row in rows]
 
 
 #: materials of the ccx backends: elastic, or bilinear elastic-plastic (``*PLASTIC``)
@@ -326,12 +343,7 @@ class CcxJobs:
         assert self.workdir is not None
         path = self.workdir / "jobs.csv"
         if self._prior_jobs is None:
-            self._prior_jobs = []
-            if path.exists():
-                with open(path, newline="") as fh:
-                    rows = list(csv.reader(fh))
-                if rows and tuple(rows[0]) == JOB_COLUMNS:
-                    self._prior_jobs = rows[1:]
+            self._prior_jobs = prior_job_rows(path)
         rows = [[rec.cycle, rec.cycles, rec.elements, rec.refine, f"{rec.penalty_scale:g}",
                  f"{rec.seconds_mesh:.4f}",
                  f"{rec.seconds_ccx:.3f}", f"{rec.seconds_read:.4f}", f"{rec.seconds_map:.4f}",
