@@ -104,3 +104,22 @@ def test_threshold_above_the_field_wears_nothing(contact) -> None:
         crit = make_criterion(name, yield_strength=ratio * h.peak_pressure, nz=17, samples=4)
         du, dl = one_cycle(solver, crit)
         assert du.max() == 0.0 and dl.max() == 0.0, name
+
+
+def test_the_lower_track_gets_the_field_between_sampled_positions(contact) -> None:
+    """Four samples of an eight-increment cycle (+A, 0, -A, 0: 300 um apart, three contact
+    radii) of a field that is the same at every position: the lower body's wear depth
+    along the track's centre line is the closed-form axis depth wherever the contact
+    centre passed (|x| <= A), not only at the sampled positions (each shift takes the
+    field of the nearer sample)."""
+    solver, h = contact
+    a, p0 = h.contact_radius, h.peak_pressure
+    t = 0.3 * p0
+    crit = make_criterion("s22", yield_strength=t, depth=3.0 * a, nz=61, samples=4)
+    _, dl = one_cycle(solver, crit)
+    ref = a * math.sqrt(p0 / t - 1.0)
+    grid = crit.grid
+    line = dl[:, grid.n // 2]
+    passed = np.abs(grid.x_lower) <= 0.3e-3 - grid.dx
+    assert passed.sum() > 3 * 0.3e-3 / a  # the track centre line, several radii long
+    assert line[passed] == pytest.approx(ref, rel=0.01)

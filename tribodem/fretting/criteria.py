@@ -96,12 +96,16 @@ class TrackGrid:
             track[..., j0 + 1 : j0 + 1 + n, :] += w * field
 
     def fold_max(self, track: NDArray[np.float64], field: NDArray[np.float64],
-                 offset: float) -> None:
+                 offset: float, swept: tuple[float, float] | None = None) -> None:
         """Pointwise maximum of a window field ``[..., n, n]`` into ``track`` at the nearest
-        track shift to ``offset`` (m) (position error <= dx / 2)."""
-        j0 = self.pad + int(round(offset / self.dx))
-        sl = track[..., j0 : j0 + self.n, :]
-        np.maximum(sl, field, out=sl)
+        track shift to ``offset`` (m) (position error <= dx / 2); with ``swept`` (lo, hi,
+        m), at every shift from lo to hi (the field held over that slide)."""
+        lo, hi = (offset, offset) if swept is None else swept
+        ja = self.pad + int(round(min(lo, offset) / self.dx))
+        jb = self.pad + int(round(max(hi, offset) / self.dx))
+        for j0 in range(ja, jb + 1):
+            sl = track[..., j0 : j0 + self.n, :]
+            np.maximum(sl, field, out=sl)
 
 
 def column_search(
@@ -316,8 +320,12 @@ class ThresholdCriterion(Criterion):
     default 8 of 48 increments: +-A/2, +-A and the two passes through 0, both directions),
     on ``nz`` levels down to ``depth`` (m; None: 3 equivalent contact radii sqrt(area/pi)
     of the first sampled increment of the run, then fixed). The per-point maximum over the
-    samples (upper: window points; lower: the track, at the nearest shift) goes through
-    :func:`column_search`.
+    samples (upper: window points; lower: the track) goes through :func:`column_search`.
+    On the lower body's track every shift the contact passed gets the field of the nearer
+    sample (``_fold_lower``): a track point between two sampled positions gets the field
+    the contact carried over it, not the tails of two distant samples (measured on the
+    seed's shear case, 2 half-space cycles: 8 samples at their own shifts only left the
+    lower worn volume 19 % under 48; docs/fretting.md "Sampled increments").
     """
 
     kind = "threshold"
@@ -362,6 +370,8 @@ class ThresholdCriterion(Criterion):
         self._up = np.full((self.nz, grid.n, grid.n), -np.inf)
         self._lo = np.full((self.nz, grid.n_track, grid.n), -np.inf)
         self._z: NDArray[np.float64] | None = None
+        self._seg: tuple[float, float] | None = None  # slide since the last sample, m
+        self._prev: tuple[float, NDArray[np.float64]] | None = None  # its offset, lower field
 
     def _depth_for(self, inc: IncrementResult) -> float:
         # None: 3 equivalent contact radii of the first sampled increment of the run,
@@ -371,8 +381,13 @@ class ThresholdCriterion(Criterion):
         return self.depth
 
     def add_increment(self, index: int, inc: IncrementResult) -> None:
+        lo, hi = sorted((inc.start_offset, inc.offset))
+        if self._seg is not None:
+            lo, hi = min(lo, self._seg[0]), max(hi, self._seg[1])
         if index not in self._idx:
+            self._seg = (lo, hi)
             return
+        self._seg = None
         depth = self._depth_for(inc)
         for body in ("upper", "lower"):
             st = self.solver.subsurface_stress(inc, body, depth=depth, nz=self.nz)
@@ -381,7 +396,26 @@ class ThresholdCriterion(Criterion):
             if body == "upper":
                 np.maximum(self._up, f, out=self._up)
             else:
-                self.grid.fold_max(self._lo, f, inc.offset)
+                self._fold_lower(f, inc.offset, lo, hi)
+
+    def _fold_lower(self, f: NDArray[np.float64], offset: float, lo: float, hi: float
+                    ) -> None:
+        """Fold the lower body's sampled field ``f`` (at ``offset``, m) into the track over
+        the slide [lo, hi] (m) since the previous sample: each shift of it gets the field
+        of the nearer of the two samples (the previous one kept; the cycle's first sample
+        takes the whole slide)."""
+        if self._prev is None:
+            self.grid.fold_max(self._lo, f, offset, swept=(lo, hi))
+        else:
+            s0, f0 = self._prev
+            mid = 0.5 * (s0 + offset)
+            if offset >= s0:  # shifts below mid are nearer the previous sample
+                self.grid.fold_max(self._lo, f0, s0, swept=(lo, mid))
+                self.grid.fold_max(self._lo, f, offset, swept=(mid, hi))
+            else:
+                self.grid.fold_max(self._lo, f0, s0, swept=(mid, hi))
+                self.grid.fold_max(self._lo, f, offset, swept=(lo, mid))
+        self._prev = (offset, f)
 
     def depths(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         assert self._z is not None, "no sampled increment in this cycle"
