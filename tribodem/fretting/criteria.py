@@ -415,7 +415,7 @@ class ThresholdCriterion(Criterion):
             else:
                 self.grid.fold_max(self._lo, f0, s0, swept=(mid, hi))
                 self.grid.fold_max(self._lo, f, offset, swept=(lo, mid))
-        self._prev = (offset, f)
+        self._prev = (offset, f.copy())  # the solver may reuse the array it returned
 
     def depths(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         assert self._z is not None, "no sampled increment in this cycle"
