@@ -111,7 +111,7 @@ def test_the_lower_track_gets_the_field_between_sampled_positions(contact) -> No
     radii) of a field that is the same at every position: the lower body's wear depth
     along the track's centre line is the closed-form axis depth wherever the contact
     centre passed (|x| <= A), not only at the sampled positions (each shift takes the
-    field of the nearer sample)."""
+    two samples' fields interpolated to it)."""
     solver, h = contact
     a, p0 = h.contact_radius, h.peak_pressure
     t = 0.3 * p0
