@@ -627,7 +627,8 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         out.write("*SURFACE INTERACTION, NAME=SI\n")
         out.write(f"*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR\n{_fmt(k_n)}{tension}\n")
         mu = max(s.mu, s.mu_loading)
-        out.write(f"*FRICTION\n{mu}, {_fmt(s.stick_factor * k_n)}\n")
+        h = mesh.h_fine
+        out.write(f"*FRICTION\n{mu}, {_fmt(s.stick_slope(lo_m.young, up_m.young, h))}\n")
         sliding = ", SMALL SLIDING" if self.small_sliding else ""
         out.write(f"*CONTACT PAIR, INTERACTION=SI, TYPE={s.formulation}{sliding}\nSUP, SLOW\n")
         n_load = PLASTIC_LOAD_INCREMENTS if self.plastic else 4
@@ -637,8 +638,9 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         fixed = "SYMY, 2, 2\nLBOT, 1, 3\n"
         out.write("*BOUNDARY\n" + fixed)
 
-        def friction(value: float, factor: float) -> str:
-            return f"*CHANGE FRICTION, INTERACTION=SI\n*FRICTION\n{value}, {_fmt(factor * k_n)}\n"
+        def friction(value: float, loading: bool) -> str:
+            k_t = s.stick_slope(lo_m.young, up_m.young, h, loading)
+            return f"*CHANGE FRICTION, INTERACTION=SI\n*FRICTION\n{value}, {_fmt(k_t)}\n"
 
         def outputs(tp: str) -> str:
             return (f"*NODE PRINT, NSET=LBOT, TOTALS=ONLY, TIME POINTS={tp}\nRF\n"
@@ -654,7 +656,7 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
 
         refine = max(int(refine), 1)
         out.write("*STEP, INC=200\n" + _static(0.5, 1.0, 1e-4, 0.5))
-        out.write(friction(s.mu_loading, s.stick_factor_loading))
+        out.write(friction(s.mu_loading, True))
         out.write(f"*BOUNDARY\n{ref}, 1, 1, 0.\n{ref}, 3, 3, {_fmt(-seat)}\n*END STEP\n")
         dt = 1.0 / (n_load * refine)
         out.write("*STEP, INC=1000\n" + _static(dt, 1.0, dt * 1e-4, dt))
@@ -672,7 +674,7 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         for k, target in enumerate(targets):
             out.write("*STEP, INC=10000\n" + _static(dt0, 1.0, min(dt0, dt * 1e-4), dt))
             if k == 0:
-                out.write(friction(s.mu, s.stick_factor))
+                out.write(friction(s.mu, False))
             out.write(f"*BOUNDARY\n{ref}, 1, 1, {_fmt(target)}\n")
             out.write(outputs("TQUARTER") + "*END STEP\n")
         if self.plastic:  # lift the upper body off, load removed: the residual surfaces
