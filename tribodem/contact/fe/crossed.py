@@ -38,7 +38,14 @@ from numpy.typing import NDArray
 
 from tribodem.contact.base import ElasticBody, contact_modulus
 from tribodem.contact.fe.ccx import run_ccx
-from tribodem.contact.fe.deck import FEMaterial, _fmt, _static, _time_points, _write_ids
+from tribodem.contact.fe.deck import (
+    ContactSettings,
+    FEMaterial,
+    _fmt,
+    _static,
+    _time_points,
+    _write_ids,
+)
 from tribodem.contact.fe.mesh import graded_half, graded_symmetric
 from tribodem.contact.fe.results import read_dat, tributary_length
 from tribodem.contact.geometry import HertzSphere
@@ -62,7 +69,6 @@ class CrossedCase:
     zone_factor: float = 1.5  #: fine zone half-width and depth, in units of a
     size_factor: float = 10.0  #: body extent (x, y, height), in units of a
     growth: float = 1.3  #: element size ratio outside the fine zone
-    penalty_factor: float = 50.0  #: contact stiffness = factor x E / h, Pa/m
     load_increments: int = 4
     material: FEMaterial = field(default_factory=FEMaterial)
     #: tangential displacement amplitude of the upper body along x, m (0: normal load only,
@@ -70,9 +76,10 @@ class CrossedCase:
     delta: float = 0.0
     n_increments: int = 8  #: increments of the tangential cycle (multiple of 4)
     half_cycle: bool = False  #: only 0 -> +delta (n_increments / 4 increments)
-    mu: float = 0.6  #: Coulomb friction in the tangential step (seed: 0.6)
-    stick_factor: float = 0.1  #: stick slope = factor x the normal contact stiffness
-    mu_loading: float = 1e-3  #: friction while seating and loading (ccx refuses 0)
+    #: the interface law: Coulomb mu in the tangential step (seed: 0.6), mu_loading while
+    #: seating and loading (ccx refuses 0), normal penalty penalty_factor x E / h and stick
+    #: slope stick_factor x that (surface-to-surface, as validated)
+    contact: ContactSettings = field(default_factory=ContactSettings)
 
     @property
     def half(self) -> bool:
@@ -268,12 +275,14 @@ def write_crossed_deck(path: str | Path, mesh: Mesh3D, case: CrossedCase) -> Pat
         if int(n) != ref:
             for d in dofs:
                 out.write(f"2\n{int(n)}, {d}, 1., {ref}, {d}, -1.\n")
-    k_n = case.penalty_factor * m.young / mesh.h_fine
+    c = case.contact
+    k_n = c.normal_penalty(m.young, m.young, mesh.h_fine)
     out.write("*SURFACE INTERACTION, NAME=SI\n")
     out.write(f"*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR\n{_fmt(k_n)}\n")
-    friction = case.half and case.mu > 0
+    friction = case.half and c.mu > 0
     if friction:
-        out.write(f"*FRICTION\n{case.mu_loading}, {_fmt(case.stick_factor * k_n)}\n")
+        out.write(f"*FRICTION\n{c.mu_loading}, "
+                  f"{_fmt(c.stick_slope(m.young, m.young, mesh.h_fine, loading=True))}\n")
     out.write("*CONTACT PAIR, INTERACTION=SI, TYPE=SURFACE TO SURFACE\nSUP, SLOW\n")
     out.write("*AMPLITUDE, NAME=STROKE\n0., 0., 1., 1., 2., 0., 3., -1.\n4., 0.\n")
     fixed = "*BOUNDARY\nSYMY, 2, 2\nLBOT, 1, 3\n" if case.half else \
@@ -308,7 +317,8 @@ def write_crossed_deck(path: str | Path, mesh: Mesh3D, case: CrossedCase) -> Pat
         out.write("*STEP, INC=10000\n" + _static(dt, total, dt * 1e-4, dt))
         if friction:
             out.write("*CHANGE FRICTION, INTERACTION=SI\n"
-                      f"*FRICTION\n{case.mu}, {_fmt(case.stick_factor * k_n)}\n")
+                      f"*FRICTION\n{c.mu}, "
+                      f"{_fmt(c.stick_slope(m.young, m.young, mesh.h_fine))}\n")
         out.write(f"*BOUNDARY, AMPLITUDE=STROKE\n{ref}, 1, 1, {_fmt(case.delta)}\n")
         out.write(outputs.format(tp="TCYCLE") + "*END STEP\n")
     path = Path(path)
@@ -486,18 +496,18 @@ def crossed_checks(folder: str | Path, threads: int = 1, h_factor: float = 4.0
     case = CrossedCase(h_fine=h, delta=5e-6, n_increments=16, half_cycle=True)
     tang = run_crossed(case, Path(folder) / "crossed_tangential", threads)
     ref = tang.loaded
-    k_n = case.penalty_factor * case.material.young / h
-    slope = case.stick_factor * k_n
+    mu = case.contact.mu
+    slope = case.contact.stick_slope(case.material.young, case.material.young, h)
     for s in tang.states:
         if s.time <= 2.0 + 1e-9:
             continue
-        ratio = abs(s.tangential_force) / (case.mu * s.normal_force)
+        ratio = abs(s.tangential_force) / (mu * s.normal_force)
         if ratio < 0.97:
-            c_fe = mindlin_stick_radius(s, ref, case.mu, slope, h)
+            c_fe = mindlin_stick_radius(s, ref, mu, slope, h)
             c_ref = a * (1.0 - ratio) ** (1.0 / 3.0)
             out.append(check(f"3D Mindlin stick radius (m) at Q/(mu P) = {ratio:.2f}",
                              c_fe, c_ref, max(0.05 * c_ref, h), absolute=True))
     last = tang.states[-1]
     out.append(check("3D gross slip Q = mu P (delta = 5 um)", abs(last.tangential_force),
-                     case.mu * last.normal_force, 0.01))
+                     mu * last.normal_force, 0.01))
     return out
