@@ -103,6 +103,41 @@ def test_morphing_worn_volume_is_exact(tmp_path: Path) -> None:
     np.testing.assert_allclose(after / before, (height - d) / height, rtol=1e-9)
 
 
+def test_a_slope_limited_morph_keeps_the_worn_volume(tmp_path: Path) -> None:
+    """``max_wear_slope``: the morphed surfaces step by at most s x the column spacing and
+    carry the same worn volume as the unlimited morph (a paraboloid pit, slope 0.4 at its
+    rim, 0.13 between the columns it is projected on, limited to 0.1)."""
+    base_up, base_lo = crossed_cylinders()
+    meshes = {}
+    for s in (None, 0.1):
+        solver = _solver(tmp_path / str(s), max_wear_slope=s)
+        h = solver._mesh0.h_fine
+        d0, b = 0.3 * h, 1.5 * h
+
+        def pit(x: np.ndarray, y: np.ndarray, d0: float = d0, b: float = b) -> np.ndarray:
+            return d0 * np.maximum(0.0, 1 - (x * x + y * y) / (b * b))
+        solver.set_surfaces(lambda x, y: base_up(x, y) + pit(x, y),
+                            lambda x, y: base_lo(x, y) + pit(x, y))
+        meshes[s] = (solver, solver.morphed_mesh())
+    (plain, m0), (limited, m1) = meshes[None], meshes[0.1]
+    for body, inward in (("upper", 1.0), ("lower", -1.0)):
+        assert limited.worn_volume(body, m1) == pytest.approx(plain.worn_volume(body, m0),
+                                                              rel=1e-9)
+        top = mesh_columns(m1)[body][..., 0]
+        w = (m1.nodes[top, 2] - limited._mesh0.nodes[top, 2]) * inward
+        xs, ys = limited._grids[body]
+        steps = max((np.abs(np.diff(w, axis=1)) / np.diff(xs)).max(),
+                    (np.abs(np.diff(w, axis=0)) / np.diff(ys)[:, None]).max())
+        lim = limited.slope_limits[body]
+        assert lim.steepest_before > 0.12 and steps <= 0.1 * 1.001
+        assert lim.steepest_after == pytest.approx(steps, rel=1e-9)
+    # a job failing on the steeper surfaces names the remedy; with the limit set, nothing
+    assert "max_wear_slope = 0.1" in plain._steepness_hint()
+    assert limited._steepness_hint() == ""
+    with pytest.raises(ValueError, match="max_wear_slope"):
+        _solver(tmp_path / "bad", max_wear_slope=0.0)
+
+
 def test_deck_fields_fit_ccx(tmp_path: Path) -> None:
     """ccx reads each data field as at most 20 characters: a minimum increment written as
     ``8.333333333333334e-06`` (48 increments a cycle) was read as 8.3 and ccx stopped ("a

@@ -26,6 +26,7 @@ from tribodem.contact import (
     contact_modulus,
 )
 from tribodem.contact.fe.backend import PLASTIC_MIN_INCREMENTS
+from tribodem.contact.fe.backend3d import CONVERGED_SLOPE
 from tribodem.contact.fe.ccx import CcxNotFoundError
 from tribodem.contact.geometry import (
     CrossedCylinders,
@@ -324,6 +325,21 @@ class FEConfig(_Model):
     cache: str | None = Field(None, description="folder of finished ccx jobs keyed by the "
                               "deck's bytes and the ccx build: a deck found there is not run "
                               "again (the chapter 6 study shares one across its stages)")
+    max_wear_slope: float | None = Field(
+        CONVERGED_SLOPE, description="fe3d: the steepest step of the worn depth between "
+        "neighbouring node columns / their spacing that the morphed mesh carries; steeper "
+        "steps are relaxed volume for volume (contact.fe.slope; the default is the steepest "
+        "on which ccx's contact converged, measured; 'off': the criterion's surface as "
+        "projected, docs/fe3d.md 'Worn geometry')")
+
+    @field_validator("max_wear_slope", mode="before")
+    @classmethod
+    def _slope_or_off(cls, v: Any) -> float | None:
+        if v == "off" or v is None:
+            return None
+        if isinstance(v, bool) or not isinstance(v, int | float) or not 0 < v <= 10:
+            raise ValueError("allowed: a number > 0 and <= 10 (a slope), or 'off'")
+        return float(v)
 
 
 class FrettingConfig(_Model):
@@ -716,8 +732,11 @@ def build_solver(cfg: FrettingConfig) -> FirstBodySolver:
         takes = inspect.signature(backend).parameters
         for k in [k for k in fe if k not in takes]:  # an [fe] field this backend lacks
             if fe[k] != type(cfg.fe).model_fields[k].default:
+                has = [name for name in ("fe", "fe3d")
+                       if k in inspect.signature(BACKENDS[name]).parameters]
                 raise ConfigError(f"fe.{k} = {fe[k]!r}: solver = {cfg.solver!r} does not "
-                                  f"take it; allowed: leave fe.{k} out (solver = 'fe' has it)")
+                                  f"take it; allowed: leave fe.{k} out (solver = "
+                                  f"{' or '.join(repr(n) for n in has)} has it)")
             del fe[k]
         kw |= fe | {"amplitude": c.amplitude, "n_increments": c.n_increments,
                     "stress_depth": cfg.wear.stress_depth}
@@ -811,9 +830,13 @@ def _jsonable(cfg: FrettingConfig) -> dict[str, Any]:
     return json.loads(json.dumps(cfg.model_dump()))
 
 
-#: Config fields a resumed run may change: ``cycles`` (raised, to extend a run) and the
-#: ``[output]`` table (what is written, not the numbers).
-RESUME_MAY_CHANGE = ("cycles", "output.", "fe.threads", "fe.timeout", "fe.cache")
+#: Config fields a resumed run may change: ``cycles`` (raised, to extend a run), the
+#: ``[output]`` table (what is written, not the numbers), how ccx runs (threads, time limit,
+#: job cache) and, to go on from a stopped finite-element cycle, its retries and the worn
+#: surface's slope limit (the cycles after the resume are then another run's: each cycle's
+#: ``wear_slope_limit`` in summary.json says whether it had one).
+RESUME_MAY_CHANGE = ("cycles", "output.", "fe.threads", "fe.timeout", "fe.cache",
+                     "fe.retries", "fe.max_wear_slope")
 
 
 def check_resume(cfg: FrettingConfig, meta: dict[str, Any], path: Path) -> None:
@@ -833,7 +856,8 @@ def check_resume(cfg: FrettingConfig, meta: dict[str, Any], path: Path) -> None:
         raise ConfigError(
             f"--resume: the config differs from the one checkpoint '{path}' was made with: "
             + "; ".join(diffs) + "; allowed: the checkpoint's values (only cycles, to extend "
-            "the run, and the [output] table may change)")
+            "the run, the [output] table and fe.threads / timeout / cache / retries / "
+            "max_wear_slope may change)")
     done = int(meta.get("cycles_done", 0))
     if cfg.cycles < done:
         raise ConfigError(f"cycles = {cfg.cycles}: checkpoint '{path}' is already at cycle "

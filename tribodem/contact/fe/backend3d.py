@@ -80,6 +80,7 @@ from tribodem.contact.fe.backend import (
     cell_average,
 )
 from tribodem.contact.fe.ccx import (
+    CcxConvergenceError,
     FESolverStopped,
     ccx_build,
     find_ccx,
@@ -105,6 +106,7 @@ from tribodem.contact.fe.deck import (
 from tribodem.contact.fe.jobs import CcxJobs, JobRecord, check_stress_depth, run_job
 from tribodem.contact.fe.mesh import surface_projection, worn_depth
 from tribodem.contact.fe.results import DatBlock, read_dat
+from tribodem.contact.fe.slope import SlopeLimit, limit_slope, steepest
 from tribodem.contact.geometry import HertzSphere, crossed_cylinders
 from tribodem.contact.halfspace import max_shear, von_mises
 from tribodem.materials.en24t import EN24T
@@ -126,6 +128,10 @@ PENALTY_FACTOR = 10.0
 #: many cutbacks"); from 1/4 of it, 1-3; the elastic quick case (+-0.3 mm, 48 increments)
 #: stopped at its first reversal after 6 (docs/fe3d.md, measured)
 REVERSAL_SLIDE = 0.25
+#: the steepest worn-depth step / column spacing on which the seed's elastic-plastic shear
+#: run converged (docs/fe3d.md "Worn geometry": cycle 2 on 0.093 / 0.099 converged, cycle 3
+#: on 0.22 / 0.24 did not, h = a/3); a job that fails on steeper surfaces says so
+CONVERGED_SLOPE = 0.1
 
 #: modes of :class:`FE3DContactSolver` (``chained`` is the 2D backend's only)
 MODES = ("fresh", "primed")
@@ -273,11 +279,13 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
     mesh; ``stress_depth`` (m): how deep the column stresses are printed (None: 4.5 a, 1.5 x
     the threshold criteria's default grid depth 3 a); ``threads``, ``timeout`` (s per ccx
     job), ``retries`` (after a non-convergence: :func:`.jobs.attempt_settings`, halved
-    increments, then a softer contact);
+    increments, then a softer contact); ``max_wear_slope``: the steepest worn-depth step /
+    column spacing the morphed mesh carries (:func:`.slope.limit_slope`, volume kept; default
+    :data:`CONVERGED_SLOPE`; None: the criterion's surface as projected);
     ``workdir``: the jobs' folder (``cycle_0001/`` ...; None: a new temporary folder).
     ``regime`` and ``tolerance`` are the half-space's options and are not used, nor is
-    ``chain_cycles`` (mode ``chained`` of the 2D backend); ``material`` must be
-    ``"elastic"``.
+    ``chain_cycles`` (mode ``chained`` of the 2D backend); ``material`` is ``"elastic"`` or
+    ``"elastic-plastic"`` (bilinear EN24T by default, fresh cycles).
     """
 
     name = "fe3d"
@@ -332,6 +340,7 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         timeout: float = 1800.0,
         retries: int = 1,
         cache: str | Path | None = None,
+        max_wear_slope: float | None = CONVERGED_SLOPE,
         workdir: str | Path | None = None,
         executable: str | None = None,
         stress_depth: float | None = None,
@@ -412,6 +421,14 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         if int(retries) != retries or retries < 0:
             raise ValueError(f"retries = {retries!r} is not allowed: an integer >= 0")
         self.retries = int(retries)
+        if max_wear_slope is not None and not (math.isfinite(max_wear_slope)
+                                               and max_wear_slope > 0.0):
+            raise ValueError(f"max_wear_slope = {max_wear_slope!r} is not allowed: a number "
+                             "> 0 (the steepest step / column spacing the mesh carries) or "
+                             "None (off)")
+        #: the steepest worn-depth step / column spacing the morphed mesh carries (None: the
+        #: criterion's surface as projected; :func:`.slope.limit_slope`)
+        self.max_wear_slope = None if max_wear_slope is None else float(max_wear_slope)
         #: folder of finished ccx jobs keyed by deck (:func:`.jobs.run_job`; None: no cache)
         self.cache: Path | None = None if cache is None else Path(cache)
         self.workdir: Path | None = None if workdir is None else Path(workdir)
@@ -451,6 +468,8 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         np.add.at(count, bottom, 1.0)
         np.add.at(count, ucont, -1.0)
         self._complete = count[self._cols["upper"][..., 0]] == 0.0
+        #: per body, what ``max_wear_slope`` did to the last :meth:`column_wear`
+        self.slope_limits: dict[str, SlopeLimit] = {}
         self.reset()
         self._cycle = 0
         self._job_key: tuple[bytes, ...] | None = None
@@ -522,14 +541,22 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         current recession minus the unworn one (upper: its own frame, lower: lab frame,
         clipped at zero) onto the surface nodes; zero outside the window (upper) and the
         window plus the stroke (lower) along x, and beyond the window's last point along y,
-        where the loop gives no surface. The morphed mesh so loses the loop's worn volume."""
+        where the loop gives no surface. The morphed mesh so loses the loop's worn volume.
+        With ``max_wear_slope`` the depths are then relaxed, volume for volume, until no
+        step between neighbouring columns is steeper (:func:`.slope.limit_slope`; what it
+        did per body in :attr:`slope_limits`)."""
         c = self.coords
         out = []
         for body, now, base, lo, hi in (
                 ("upper", self.upper, self._base_upper, c[0], c[-1]),
                 ("lower", self.lower, self._base_lower, c[0] - self.pad, c[-1] + self.pad)):
-            out.append(surface_projection(worn_depth(now, base), *self._grids[body],
-                                      (lo, hi, -np.inf, c[-1]), 0.5 * self.dx))
+            w = surface_projection(worn_depth(now, base), *self._grids[body],
+                                   (lo, hi, -np.inf, c[-1]), 0.5 * self.dx)
+            if self.max_wear_slope is not None and w.any():
+                w, lim = limit_slope(w, *self._grids[body], self._areas[body],
+                                     self.max_wear_slope)
+                self.slope_limits[body] = lim
+            out.append(w)
         return out[0], out[1]
 
     def morphed_mesh(self) -> Mesh3D:
@@ -815,10 +842,16 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         mesh = self.morphed_mesh()
         seat = self._seat(mesh)
         t_mesh = time.perf_counter() - t0
-        run, refine, scale, t_deck, t_ccx = run_job(
-            lambda refine, name, scale: self.write_deck(folder / f"{name}.inp", mesh, seat,
-                                                        refine, scale),
-            self.retries, self.threads, self.timeout, self.executable, self.cache)
+        try:
+            run, refine, scale, t_deck, t_ccx = run_job(
+                lambda refine, name, scale: self.write_deck(folder / f"{name}.inp", mesh,
+                                                            seat, refine, scale),
+                self.retries, self.threads, self.timeout, self.executable, self.cache)
+        except CcxConvergenceError as err:
+            hint = self._steepness_hint()
+            if hint:
+                raise FESolverStopped(f"{err}\n{hint}") from None
+            raise
         self._penalty_scale = scale
         t_mesh += t_deck
         t3 = time.perf_counter()
@@ -1204,6 +1237,15 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
                 "traction_drop": (last - first) / first if first > 0 else 0.0}
         fx = [abs(float(self._state_of[times[k]]["force"][0])) for k in (quarter, 3 * quarter)]
         row["q_over_mu_p_at_plus_minus_a"] = [v / (self.friction * self.load) for v in fx]
+        if self.max_wear_slope is not None and self.slope_limits:
+            # the job's surfaces are the criterion's relaxed to max_wear_slope: say how much
+            row["wear_slope_limit"] = {
+                "max_wear_slope": self.max_wear_slope,
+                **{body: {"steepest_before": lim.steepest_before,
+                          "steepest_after": lim.steepest_after,
+                          "moved_volume_m3": 2.0 * lim.moved_volume,  # both halves
+                          "worn_volume_m3": self.worn_volume(body), "converged": lim.converged}
+                   for body, lim in self.slope_limits.items()}}
         return row
 
     def report(self) -> dict[str, Any]:
@@ -1219,8 +1261,39 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         return {"backend": "fe3d", "mode": self.mode, "material": self.material,
                 "ccx": ccx_build(self.executable),
                 "fe3d": {"elements": int(self._mesh0.elements.shape[0]),
-                         "h_fine_m": self._mesh0.h_fine, "size_factor": self.size_factor},
+                         "h_fine_m": self._mesh0.h_fine, "size_factor": self.size_factor,
+                         "max_wear_slope": self.max_wear_slope,
+                         "worn_surface": self._worn_surface_reading()},
                 "profile": self.profile(), "cycles": list(self.cycle_reports)}
+
+    def _steepness_hint(self) -> str:
+        """What to do when a job on worn surfaces steeper than :data:`CONVERGED_SLOPE` did
+        not converge ('' when they are not, or a slope limit is set)."""
+        if self.max_wear_slope is not None:
+            return ""
+        steep = {body: float(steepest(w, *self._grids[body]))
+                 for body, w in zip(BODIES, self.column_wear(), strict=True)}
+        if max(steep.values()) <= CONVERGED_SLOPE:
+            return ""
+        return ("the worn surfaces step by up to "
+                + ", ".join(f"{v:.2f} ({b})" for b, v in steep.items())
+                + f" x the spacing of neighbouring node columns; ccx's contact converged here "
+                f"on up to {CONVERGED_SLOPE:g} (docs/fe3d.md 'Worn geometry'): to go on, "
+                f"set [fe] max_wear_slope = {CONVERGED_SLOPE:g} (the default, here 'off') "
+                "in the config and --resume (the mesh's worn depth relaxed to that slope, the "
+                "worn volume kept), or run a finer mesh (fe.h_over_a)")
+
+    def _worn_surface_reading(self) -> str:
+        """Which worn surface the jobs' meshes carry (for summary.json)."""
+        if self.max_wear_slope is None:
+            return ("the criterion's worn depth, lumped-projected onto the node columns "
+                    "(eqs 3.7-3.8)")
+        return (f"the criterion's worn depth, lumped-projected onto the node columns, then "
+                f"relaxed volume for volume until no step between neighbouring columns is "
+                f"steeper than {self.max_wear_slope:g} x their spacing (fe.max_wear_slope): "
+                "the FE geometry is smoother than the scar the loop reports; per cycle "
+                "'wear_slope_limit' gives the steepest step before and after and the volume "
+                "moved")
 
     # -- resume ---------------------------------------------------------------------------
     def state_dict(self) -> dict[str, Any]:
