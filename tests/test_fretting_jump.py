@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 
 from tribodem.contact import HalfSpaceSolver
+from tribodem.contact.geometry import SEED_RADIUS, HertzSphere
 from tribodem.cyclejump import make_strategy
 from tribodem.fretting import FrettingLoop, make_criterion
 
@@ -38,7 +39,7 @@ def run(strategy, geometry_tolerance="default"):  # noqa: ANN001, ANN201
                         n_increments=4, strategy=strategy, **kw)
     h = loop.run(N)
     j = h.grid.n // 2
-    return h, float(h.wear_upper.max()), scar_width(h.wear_upper[:, j], h.grid.dx)
+    return h, float(h.wear_upper.max()), scar_width(h.wear_upper[:, j], h.grid.dx), loop
 
 
 @pytest.fixture(scope="module")
@@ -47,19 +48,34 @@ def reference():  # noqa: ANN201
 
 
 def test_default_jumping_keeps_the_scar(reference) -> None:
-    _, depth_ref, width_ref = reference
-    h, depth, width = run(make_strategy("adaptive", decide_on="total"))
+    _, depth_ref, width_ref, _ = reference
+    h, depth, width, loop = run(make_strategy("adaptive", decide_on="total"))
     print(f"simulated {h.cycles_simulated}, depth {depth / depth_ref - 1:+.2%}, "
           f"width {width / width_ref - 1:+.2%}")
     assert h.cycles_simulated <= 0.1 * N  # >= 90% of the cycles saved
     assert depth == pytest.approx(depth_ref, rel=0.05)
     assert width == pytest.approx(width_ref, rel=0.05)
     assert h.volume("upper") == pytest.approx(reference[0].volume("upper"), rel=0.01)
+    # the decisions the summary reports add up, and the geometry cut jumps here
+    d = loop.jump_decisions()
+    assert d["cycles_jumped"] == h.cycles_jumped
+    assert d["decisions"] >= h.cycles_simulated - 1
+    assert 0 < d["capped_by_geometry"] <= d["proposed"] <= d["decisions"]
+    # the approach of the first decision (after cycle 1, nearly unworn) is Hertz's a^2 / R
+    # of the crossed cylinders' sphere on flat (R = D / 2), within the grid's resolution
+    # of the contact area (5 %)
+    hertz = HertzSphere(SEED_RADIUS, loop.solver.load, loop.solver.modulus).approach
+    assert d["first"]["elastic_approach_m"] == pytest.approx(hertz, rel=0.05)
+    last = d["last"]
+    assert last["geometry_limit"] == int(0.05 * last["elastic_approach_m"]
+                                         / last["depth_increment_m"])
 
 
 def test_without_geometry_control_the_scar_is_wrong(reference) -> None:
-    _, depth_ref, _ = reference
-    h, depth, _ = run(make_strategy("adaptive", decide_on="total"), geometry_tolerance=None)
+    _, depth_ref, _, _ = reference
+    h, depth, _, loop = run(make_strategy("adaptive", decide_on="total"),
+                            geometry_tolerance=None)
+    assert loop.jump_decisions()["capped_by_geometry"] == 0
     assert depth > 1.3 * depth_ref  # what the control prevents (1.7x here, 4x at 64^2)
 
 

@@ -150,6 +150,10 @@ def test_resume_with_jumping_equals_uninterrupted(tmp_path: Path,
     _in_process(tmp_path, monkeypatch, "jump", cycles, {"jump": jump}, stop_after)
     rows = (tmp_path / "jump_a" / "results.csv").read_text().splitlines()[1:]
     assert any(r.split(",")[1] == "1" for r in rows), "no cycle was jumped"
+    # the summary's decisions (compared whole above, so carried through the checkpoint)
+    d = json.loads((tmp_path / "jump_b" / "summary.json").read_text())["jump"]
+    assert d["decisions"]["cycles_jumped"] == sum(r.split(",")[1] == "1" for r in rows)
+    assert "cycles were jumped" in d["reading"] or "proposed no jump" in d["reading"]
 
 
 def test_resume_with_debris_equals_uninterrupted(tmp_path: Path,

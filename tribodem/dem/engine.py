@@ -721,12 +721,7 @@ class Simulation:
         event: a neighbour rebuild, an interaction's event, a failed stability check or a
         recorder sample (those run here, in Python, as in ``_python_step``; a passed
         check needs no return). Returns the steps done (>= 1)."""
-        self._refresh_walls()
-        self._maybe_rebuild()
-        limit = nmax
-        for every, _ in self.recorders:
-            limit = min(limit, every - self.step_count % every)
-        c = self._context()
+        c, limit = self._compiled_begin(nmax)
         if self._threaded():
             with numba.parallel_chunksize(THREADED_CHUNK):
                 k, _why, _events = _run_steps(c, states, limit, self.step_count,
@@ -736,6 +731,24 @@ class Simulation:
             k, _why, _events = _run_steps(c, states, limit, self.step_count,
                                           self.check_every, self.max_overlap_ratio, None,
                                           None, None)
+        return self._compiled_end(c, states, k)
+
+    def _compiled_begin(self, nmax: int) -> tuple[StepContext, int]:
+        """Before a run of the compiled loop: the walls' arrays, a neighbour rebuild if
+        due, the context, and how many steps (at most ``nmax``) may run before the next
+        recorder sample. ``benchmarks/profile_step.py`` steps kernel by kernel between
+        this and :meth:`_compiled_end`."""
+        self._refresh_walls()
+        self._maybe_rebuild()
+        limit = nmax
+        for every, _ in self.recorders:
+            limit = min(limit, every - self.step_count % every)
+        return self._context(), limit
+
+    def _compiled_end(self, c: StepContext, states: tuple, k: int) -> int:
+        """After ``k`` steps of the compiled loop on context ``c``: the walls' state and
+        totals back into the wall objects, the counters, the interactions'
+        ``after_compiled`` hooks, the stability check and the recorders. Returns ``k``."""
         self._evaluated = True
         rows = c.wall_tot.tolist()
         for w_id, w in enumerate(self.walls):

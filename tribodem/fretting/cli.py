@@ -630,6 +630,33 @@ def check_solved_window(cfg: FrettingConfig, solver: FirstBodySolver) -> None:
             " allowed: a larger contact.window (and maps covering it) or a smaller load")
 
 
+def jump_reading(loop: FrettingLoop) -> dict[str, Any]:
+    """The run's jump decisions (``FrettingLoop.jump_decisions``) and one sentence on what
+    limited the jumps, for summary.json's ``jump``."""
+    d = loop.jump_decisions()
+    tol, last = d["geometry_tolerance"], d["last"]
+    if not d["decisions"]:
+        text = "no jump decision yet (no simulated cycle was shown to the strategy)"
+    elif tol is None:
+        text = ("geometry control off (jump.geometry_tolerance = 0): every jump as the "
+                f"strategy proposed it; {d['cycles_jumped']} cycles jumped")
+    else:
+        text = (f"the strategy proposed no jump in {d['decisions']} decisions"
+                if not d["proposed"] else
+                f"the strategy proposed a jump in {d['proposed']} of {d['decisions']} "
+                f"decisions; the geometry (jump.geometry_tolerance = {tol:g}: a jump adds "
+                f"at most {tol:.0%} of the contact's elastic approach to the depth anywhere)"
+                f" cut {d['capped_by_geometry']} of them; {d['cycles_jumped']} cycles were "
+                "jumped")
+        if last["geometry_limit"] is not None and last["increment_over_approach"]:
+            text += (f"; at the last decision the last cycle's largest depth increment, "
+                     f"{last['depth_increment_m'] * 1e6:.3g} um, was "
+                     f"{last['increment_over_approach']:.3g} elastic approaches "
+                     f"({last['elastic_approach_m'] * 1e6:.3g} um), so the geometry allowed "
+                     f"{last['geometry_limit']} cycles")
+    return {"decisions": d, "reading": text}
+
+
 def case_summary(cfg: FrettingConfig, solver: FirstBodySolver) -> dict[str, Any]:
     """What ran: geometry and its parameters, contact type, load (and which was given),
     window, the two bodies and E* (SI)."""
@@ -940,7 +967,8 @@ def run_fretting(cfg: FrettingConfig, out: Path, echo: Any = None, resume: bool 
         "criterion": {"name": loop.criterion.name, "kind": loop.criterion.kind,
                       **loop.criterion.params()},
         "jump": {"strategy": cfg.jump.strategy,
-                 **({"params": loop.strategy.params()} if loop.strategy else {})},
+                 **({"params": loop.strategy.params(), **jump_reading(loop)}
+                    if loop.strategy else {})},
         "window_m": loop.solver.window,
         "contact_case": case_summary(cfg, loop.solver),
         "first_body_report": loop.solver.report(),

@@ -138,6 +138,13 @@ def _scar_mean(w: NDArray[np.float64]) -> float:
 
 #: Default of ``FrettingLoop(geometry_tolerance=...)`` (docs/fretting.md, "Jumping").
 GEOMETRY_TOLERANCE = 0.05
+#: ``_geometry_limit`` without a limit (no tolerance, or nothing worn)
+NO_LIMIT = 1 << 62
+
+
+def _no_decisions() -> dict[str, Any]:
+    return {"decisions": 0, "proposed": 0, "capped_by_geometry": 0, "cycles_proposed": 0,
+            "cycles_jumped": 0, "first": None, "last": None}
 
 
 class FrettingLoop:
@@ -198,6 +205,8 @@ class FrettingLoop:
         self.geometry_tolerance: float | None = geometry_tolerance
         self._last_du = np.zeros((n, n))
         self._last_dl = np.zeros((self.grid.n_track, n))
+        #: every jump decision so far (``jump_decisions``), for the summary
+        self._decisions = _no_decisions()
 
     def _de_phase(self) -> dict[str, float]:
         """Seed 003 figure 3.1 DE step: load the debris, map its forces back to the solver."""
@@ -335,7 +344,11 @@ class FrettingLoop:
         reached."""
         assert self.strategy is not None and self.history is not None
         self.strategy.observe(c, self._state())
-        n = min(int(self.strategy.propose_jump()), cycles - c, self._geometry_limit(per))
+        wanted = min(int(self.strategy.propose_jump()), cycles - c)
+        inc, approach = self._geometry_scale(per)
+        limit = self._geometry_limit(inc, approach)
+        n = min(wanted, limit)
+        self._note_decision(c, wanted, limit, n, inc, approach)
         if n <= 0:
             return c
         old = self._state()
@@ -355,28 +368,61 @@ class FrettingLoop:
         self.history.cycles_jumped += n
         return c + n
 
-    def _geometry_limit(self, per: dict[str, Any]) -> int:
-        """Longest jump the geometry allows (None: no limit): the jumped depth increment,
-        anywhere on either body, at most ``geometry_tolerance`` x the contact's elastic
-        approach, so the pressure the next cycle sees moves little over a jump.
+    def _geometry_scale(self, per: dict[str, Any]) -> tuple[float, float]:
+        """(largest depth increment of the last simulated cycle on either body, the
+        contact's elastic approach), m: the two lengths of ``_geometry_limit``.
 
         The approach of the last simulated cycle's contact, 3 P / (4 a E*) with a the radius
         of its mean contact area (Hertz: a^2 / R), is the scale on which a change of the
-        gap changes the pressure by its own order; the depth increment is that cycle's. A
-        line contact (no finite approach in a half-space) takes b^2 / R = 4 P' / (pi E*),
-        P' the load per unit length of the periodic window."""
-        tol = self.geometry_tolerance
+        gap changes the pressure by its own order. A line contact (no finite approach in a
+        half-space) takes b^2 / R = 4 P' / (pi E*), P' the load per unit length of the
+        periodic window."""
         inc = max(float(self._last_du.max(initial=0.0)), float(self._last_dl.max(initial=0.0)))
-        if tol is None or inc <= 0.0:
-            return 1 << 62
         sol = self.solver
         if sol.contact == "line":  # b^2 / R = 4 P' / (pi E*), P' the load per unit length
-            approach = 4.0 * sol.load / (math.pi * sol.modulus * sol.window)
-        else:
-            a = math.sqrt(max(float(per.get("contact_area_m2", 0.0)), self.grid.cell_area)
-                          / math.pi)
-            approach = 3.0 * sol.load / (4.0 * a * sol.modulus)
+            return inc, 4.0 * sol.load / (math.pi * sol.modulus * sol.window)
+        a = math.sqrt(max(float(per.get("contact_area_m2", 0.0)), self.grid.cell_area)
+                      / math.pi)
+        return inc, 3.0 * sol.load / (4.0 * a * sol.modulus)
+
+    def _geometry_limit(self, inc: float, approach: float) -> int:
+        """Longest jump the geometry allows (``NO_LIMIT``: none): the jumped depth
+        increment, anywhere on either body, at most ``geometry_tolerance`` x the contact's
+        elastic approach (``inc``, ``approach``: ``_geometry_scale``, m), so the pressure
+        the next cycle sees moves little over a jump."""
+        tol = self.geometry_tolerance
+        if tol is None or inc <= 0.0:
+            return NO_LIMIT
         return int(tol * approach / inc)
+
+    def _note_decision(self, cycle: int, wanted: int, limit: int, n: int, inc: float,
+                       approach: float) -> None:
+        """Count one jump decision after simulated cycle ``cycle``: the strategy's
+        proposal (cut at the run's end) ``wanted``, the geometry's ``limit``, the jump
+        taken ``n``, and the two lengths behind the limit (m)."""
+        d = self._decisions
+        d["decisions"] += 1
+        d["proposed"] += int(wanted > 0)
+        d["capped_by_geometry"] += int(limit < wanted)
+        d["cycles_proposed"] += max(wanted, 0)
+        d["cycles_jumped"] += max(n, 0)
+        d["last"] = {"after_cycle": int(cycle), "proposed": int(wanted),
+                     "geometry_limit": None if limit >= NO_LIMIT else int(limit),
+                     "jumped": max(int(n), 0), "depth_increment_m": inc,
+                     "elastic_approach_m": approach,
+                     "increment_over_approach": inc / approach if approach > 0 else None}
+        if d["first"] is None:
+            d["first"] = d["last"]
+
+    def jump_decisions(self) -> dict[str, Any]:
+        """What the jumps were and what limited them, for the summary: decisions (one per
+        simulated cycle shown to the strategy), how many proposed a jump, how many the
+        geometry cut (``geometry_tolerance``), the cycles proposed and jumped, and the
+        first and last decision (proposal, geometry limit, jump, the last cycle's largest
+        depth increment and the contact's elastic approach, m). ``cycles_proposed`` sums
+        every proposal (cut at the run's end), so a proposal the geometry cut and the
+        strategy makes again counts again."""
+        return {"geometry_tolerance": self.geometry_tolerance, **self._decisions}
 
     @property
     def cycles_done(self) -> int:
@@ -414,6 +460,7 @@ class FrettingLoop:
             "profiles_lower": list(hist.profiles_lower),
             "cycles_simulated": hist.cycles_simulated,
             "cycles_jumped": hist.cycles_jumped,
+            "jump_decisions": dict(self._decisions),
         }
 
     def load_state_dict(self, state: dict[str, Any]) -> None:
@@ -450,6 +497,8 @@ class FrettingLoop:
         hist.profiles_lower = list(state["profiles_lower"])
         hist.cycles_simulated = int(state["cycles_simulated"])
         hist.cycles_jumped = int(state["cycles_jumped"])
+        # checkpoints written before the decisions were counted have none
+        self._decisions = dict(state.get("jump_decisions") or _no_decisions())
         hist.wall_time_s = self._wall
         hist.de_phases = self.de_phases
         self.history = hist
