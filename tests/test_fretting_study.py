@@ -11,7 +11,15 @@ from pathlib import Path
 import pytest
 from conftest import default_sigint, run_tribodem, tribodem_exe
 
-from tribodem.fretting.study import SEED, Stage, compare, ranking, row_of, stages
+from tribodem.fretting.study import (
+    SEED,
+    Stage,
+    compare,
+    ranking,
+    row_of,
+    stages,
+    write_markdown,
+)
 
 CONFIG = """[contact]
 n = 32
@@ -66,6 +74,19 @@ def test_compare_and_ranking() -> None:
     t = {(r["stage"], r["quantity"]): r for r in compare([*rows, s22])}
     assert t[("s22", "mean_scar_depth_lower_m")]["ours"] is None
     assert ranking([*rows, s22]) == ["von_mises", "energy", "swt"]
+
+
+def test_jump_reading_reaches_study_md(tmp_path: Path) -> None:
+    """A jumping stage's summary says what limited its jumps; study.md repeats it."""
+    summary = {"cycles": 3, "cycles_simulated": 3, "wear_depth_mean_scar_lower_m": 3e-6,
+               "wear_depth_mean_scar_upper_m": 4e-6, "wear_depth_lower_m": 8e-6,
+               "wear_depth_upper_m": 9e-6, "wear_volume_lower_m3": 1e-13, "wall_time_s": 1.0,
+               "jump": {"strategy": "adaptive", "reading": "the strategy proposed no jump in "
+                        "2 decisions; ... so the geometry allowed 0 cycles"}}
+    row = row_of(Stage("shear_jump", "shear", 110, jump="adaptive"), summary)
+    assert row["jump_reading"] == summary["jump"]["reading"]
+    md = write_markdown(tmp_path, [row], compare([row]), ranking([row]), "fe3d").read_text()
+    assert f"shear_jump, cycle-jumping: {summary['jump']['reading']}." in md
 
 
 def test_study_command(tmp_path: Path) -> None:

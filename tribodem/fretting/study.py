@@ -94,6 +94,8 @@ def row_of(st: Stage, summary: dict[str, Any]) -> dict[str, Any]:
         "worn_volume_lower_m3": summary["wear_volume_lower_m3"],
         "wall_time_s": summary["wall_time_s"],
     }
+    if summary.get("jump", {}).get("reading"):  # what limited the jumps (FrettingLoop)
+        row["jump_reading"] = summary["jump"]["reading"]
     # a stage stopped before its first cycle measured nothing (not a zero rate)
     row["mean_scar_depth_per_cycle_lower_m"] = (row["mean_scar_depth_lower_m"] / n if n > 0
                                                 else None)
@@ -171,6 +173,8 @@ def write_markdown(out: Path, rows: list[dict[str, Any]], table: list[dict[str, 
             f" | {r['max_depth_lower_m'] * um:.4g} / {r['max_depth_upper_m'] * um:.4g} | "
             f"{r['mean_scar_depth_per_cycle_lower_m'] * um:.4g} | {swt} | "
             f"{r['wall_time_s']:.1f} |")
+    lines += [f"\n{r['stage']}, cycle-jumping: {r['jump_reading']}." for r in rows
+              if r.get("jump_reading")]
     lines += ["", "| stage | quantity | seed | ours | ours / seed | within 20 % (a bound "
               "\"> x\": at least x) |",
               "|---|---|---|---|---|---|"]
