@@ -104,6 +104,24 @@ def _segment(sim: E.Simulation, states: tuple, nmax: int, tim: dict[str, float])
     return k
 
 
+def new_timers() -> dict[str, float]:
+    """Zeroed CPU-second sums per kernel (interactions add their own keys)."""
+    return dict.fromkeys(("rebuild test", "rebuild + pair constants", "pair contacts",
+                          "clear ext_force/ext_torque", "wall pass", "particle update",
+                          "wall motion", "between segments (Python)"), 0.0)
+
+
+def step_by_kernel(sim: E.Simulation, steps: int, tim: dict[str, float]) -> None:
+    """``sim.step(steps)`` on one thread, kernel by kernel (the same kernels and order, so
+    the same bits as the compiled loop: ``tests/test_dem_profile_step.py``)."""
+    states = sim._compiled_states()
+    if states is None:
+        raise SystemExit("profile_step: this simulation does not run the compiled loop")
+    done = 0
+    while done < steps:
+        done += _segment(sim, states, steps - done, tim)
+
+
 def profile(case_name: str, n: int | None, steps: int, warmup: int) -> dict:
     """Per-kernel CPU time per step of ``steps`` steps of case ``case_name`` (one thread)."""
     numba.set_num_threads(1)
@@ -111,16 +129,9 @@ def profile(case_name: str, n: int | None, steps: int, warmup: int) -> dict:
     case = CASES[case_name](**kw)
     sim = simulation_from_case(case)
     sim.step(warmup)  # compiles the loop and settles the state
-    states = sim._compiled_states()
-    if states is None:
-        raise SystemExit(f"profile_step: case {case_name!r} does not run the compiled loop")
-    tim = dict.fromkeys(("rebuild test", "rebuild + pair constants", "pair contacts",
-                         "clear ext_force/ext_torque", "wall pass", "particle update",
-                         "wall motion", "between segments (Python)"), 0.0)
-    _segment(sim, states, 2, dict(tim))  # compiles the per-interaction calls
-    done = 0
-    while done < steps:
-        done += _segment(sim, states, steps - done, tim)
+    step_by_kernel(sim, 2, new_timers())  # compiles the per-interaction calls
+    tim = new_timers()
+    step_by_kernel(sim, steps, tim)
     c0 = time.process_time()
     sim.step(steps)
     loop = (time.process_time() - c0) / steps
