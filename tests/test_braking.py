@@ -372,7 +372,7 @@ def test_quick_preset_overrides_the_config_file(tmp_path: Path) -> None:
 
 
 def test_steady_state_rule() -> None:
-    from tribodem.braking.run import steady_state
+    from tribodem.braking.run import STEADY_CUTS, steady_state
 
     s = np.linspace(0.0, 3e-4, 31)
     h = np.where(s < 1e-4, 0.2 * s, 2e-5 + 0.05 * (s - 1e-4))  # fast run-in, then steady
@@ -383,6 +383,19 @@ def test_steady_state_rule() -> None:
     h2 = np.where(s < 2e-4, 0.05 * s, 1e-5 + 0.1 * (s - 2e-4))  # last third twice as fast
     assert not steady_state(s, h2)["steady"]
     assert not steady_state(s, np.zeros_like(s))["steady"]  # no wear: no steady rate
+    # a single pass by luck: run-in at 10 um/mm to 1 mm, then 2 um/mm; at 3 mm the thirds
+    # (1-2, 2-3 mm) agree, cut to 90 % (2.7 mm) the middle third still holds run-in (2.9
+    # against 2 um/mm): the test alone passes, with the cuts it does not
+    s3 = np.linspace(0.0, 3e-3, 301)
+    h3 = np.where(s3 < 1e-3, 0.01 * s3, 1e-5 + 0.002 * (s3 - 1e-3))
+    assert steady_state(s3, h3)["steady"]
+    assert not steady_state(s3, h3, cuts=STEADY_CUTS)["steady"]
+    # slid on at 2 um/mm to 4.2 mm: cut to 3.78 and 3.36 mm the thirds start past the
+    # run-in too: steady, at 2 um/mm
+    s4 = np.linspace(0.0, 4.2e-3, 421)
+    h4 = np.where(s4 < 1e-3, 0.01 * s4, 1e-5 + 0.002 * (s4 - 1e-3))
+    st = steady_state(s4, h4, cuts=STEADY_CUTS)
+    assert st["steady"] and st["rate"] == pytest.approx(0.002)
 
 
 def test_until_steady_with_a_load_ramp_resumes_bitwise(tmp_path: Path,
