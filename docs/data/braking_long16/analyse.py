@@ -54,6 +54,10 @@ def window_rates(ts: np.ndarray) -> list[float]:
     return out
 
 
+def _at(at: float, rate: float) -> str:
+    return "no pass" if at != at else f"{at * 1e3:.2f} / {rate * 1e3:.2f}"
+
+
 def main(dirs: list[Path]) -> None:
     rows, windows, passes = [], [], []
     for d in dirs:
@@ -79,8 +83,7 @@ def main(dirs: list[Path]) -> None:
           "run's second half, um/mm |\n|---|---|---|---|")
     for (name, _), ((a0, r0), (a1, r1)), w in zip(rows, passes, windows, strict=True):
         late = np.mean(w[len(w) // 2:]) if w else float("nan")
-        print(f"| {name} | {a0 * 1e3:.2f} / {r0 * 1e3:.2f} | {a1 * 1e3:.2f} / {r1 * 1e3:.2f}"
-              f" | {late * 1e3:.2f} |")
+        print(f"| {name} | {_at(a0, r0)} | {_at(a1, r1)} | {late * 1e3:.2f} |")
     depth = np.array([s["wear_depth_mean_pad_m"] for _, s in rows])
     late = np.array([np.mean(w[len(w) // 2:]) for w in windows])
     if len(rows) > 1:
