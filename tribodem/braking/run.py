@@ -266,8 +266,8 @@ def _slope(x: np.ndarray, y: np.ndarray) -> float:
 
 #: the steady-state test must hold on the run and on the run cut to these fractions of
 #: its distance: a single pass can be luck on a depth that moves in steps (session 25,
-#: ten 16-mm runs: the test alone passed in every one, at 3-14 mm, reporting rates
-#: 0.3-74x those of the runs' second halves; with the cuts it passed in none)
+#: ten 16-mm runs: the test alone passed in 9, at 3-14 mm, reporting rates 0.3-74x those
+#: of the runs' second halves; with the cuts it passed in none)
 STEADY_CUTS = (1.0, 0.9, 0.8)
 
 
