@@ -298,8 +298,9 @@ def steady_state(s: np.ndarray, h: np.ndarray, tol: float = 0.15,
     for f in cuts:
         if not ok:
             break
-        m = s <= f * s[-1] * (1.0 + 1e-12)
-        ok = bool(m.sum() >= 6 and _thirds(s[m], h[m], tol)[0])
+        if f < 1.0:  # the whole series (1.0) was just tested
+            m = s <= f * s[-1] * (1.0 + 1e-12)
+            ok = bool(m.sum() >= 6 and _thirds(s[m], h[m], tol)[0])
     a = s[-1] / 3.0
     after = s >= a
     return {"steady": bool(ok), "rate": _slope(s[after], h[after]), "rate_mid": r_mid,

@@ -18,20 +18,19 @@ from pathlib import Path
 
 import numpy as np
 
-from tribodem.braking.run import STEADY_CUTS
+from tribodem.braking.compare import _series  # the sweep comparison's timeseries reader
+from tribodem.braking.run import STEADY_CUTS, _slope, steady_state
 
 WINDOW = 2.0e-3  # m of sliding per window
 #: ``until_steady`` as the default run does it: first test after 40 us, then every 8 us
 FIRST_S, BLOCK_S = 40e-6, 8e-6
 
 
-def first_pass(ts: np.ndarray, cuts: tuple[float, ...],
+def first_pass(ts: dict[str, np.ndarray], cuts: tuple[float, ...],
                tol: float = 0.15) -> tuple[float, float]:
     """Where the tool's own rule (``tribodem.braking.run.steady_state`` with ``cuts``)
     first passes on the run's prefix, tested as ``until_steady`` tests it; (distance m,
     the steady rate it would report m/m), or NaNs if it never passes."""
-    from tribodem.braking.run import steady_state
-
     t, s, h = ts["time_s"], ts["sliding_distance_m"], ts["wear_depth_mean_pad_m"]
     at = FIRST_S
     while at <= t[-1] + 1e-12:
@@ -43,14 +42,15 @@ def first_pass(ts: np.ndarray, cuts: tuple[float, ...],
     return float("nan"), float("nan")
 
 
-def window_rates(ts: np.ndarray) -> list[float]:
-    """Wear rate of the pad (m of mean depth per m slid) in each full window."""
+def window_rates(ts: dict[str, np.ndarray]) -> list[float]:
+    """Wear rate of the pad (m of mean depth per m slid) in each full window (the
+    steady-state rule's own least-squares slope)."""
     s = ts["sliding_distance_m"]
     d = ts["wear_depth_mean_pad_m"]
     out = []
     for k in range(int(s[-1] // WINDOW)):
         m = (s >= k * WINDOW) & (s <= (k + 1) * WINDOW)
-        out.append(float(np.polyfit(s[m], d[m], 1)[0]) if m.sum() >= 3 else float("nan"))
+        out.append(_slope(s[m], d[m]) if m.sum() >= 3 else float("nan"))
     return out
 
 
@@ -62,7 +62,7 @@ def main(dirs: list[Path]) -> None:
     rows, windows, passes = [], [], []
     for d in dirs:
         s = json.loads((d / "summary.json").read_text())
-        ts = np.genfromtxt(d / "timeseries.csv", delimiter=",", names=True)
+        ts = _series(d)
         windows.append(window_rates(ts))
         passes.append((first_pass(ts, (1.0,)), first_pass(ts, STEADY_CUTS)))
         rows.append((d.name, s))
