@@ -1,0 +1,78 @@
+"""Issue 15: seed 000's two trends asked of the saturated wear depth, not of the run-in.
+
+    python docs/data/braking_trends12/analyse.py C5_DIR_PATTERN C1_DIR_PATTERN C3_DIR_PATTERN
+
+Each pattern holds ``{k}`` for the packing (e.g. ``runs/fixed_p{k}``). The runs are the
+default cell with the 324-um pad (``docs/data/braking_long16/fixed.toml``) of conditions 5
+(21 kN, 1200 r/min), 1 (13 kN, 1200 r/min) and 3 (21 kN, 800 r/min) on the same packings
+(``[geometry] seed`` K), slid at least ``AT`` (12 mm). Per packing and condition: the pad's
+mean wear depth at 1.9 mm (the seed's 40 us at 1200 r/min: the run-in) and at ``AT``, and
+the rate over the last ``LATE`` of it (is the depth saturated?). Then the paired changes
+13 -> 21 kN (condition 1 -> 5) and 800 -> 1200 r/min (3 -> 5) with their 95 % intervals
+(``tribodem.braking.compare``, as the sweeps compute them), beside the seed's +24.75 % and
++16.22 %. Conditions are compared at the same sliding distance (the saturated depth is
+reached in distance, not in time); the time each took is printed. Markdown on stdout.
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from tribodem.braking.compare import _series, change_with_error, ci95, seed_inside
+from tribodem.braking.run import _slope
+
+AT = 12.0e-3  # m slid: where the depth is compared
+RUN_IN = 1.885e-3  # m: the seed's 40 us at 47.12 m/s
+LATE = 2.0e-3  # m: the window of the late rate
+SEED = {"13 -> 21 kN (1 -> 5)": (1, 24.75), "800 -> 1200 r/min (3 -> 5)": (3, 16.22)}
+
+
+def reading(d: Path) -> dict[str, float]:
+    """Depths at RUN_IN and AT, the late rate (m/m) and the time to AT, of one run."""
+    ts = _series(d)
+    s, h, t = ts["sliding_distance_m"], ts["wear_depth_mean_pad_m"], ts["time_s"]
+    if s[-1] < AT * (1 - 1e-3):
+        raise SystemExit(f"{d}: slid {s[-1] * 1e3:.2f} mm, less than {AT * 1e3:.0f} mm")
+    m = (s >= AT - LATE) & (s <= AT)
+    return {"run_in": float(np.interp(RUN_IN, s, h)), "at": float(np.interp(AT, s, h)),
+            "late": _slope(s[m], h[m]), "t_at": float(np.interp(AT, s, t))}
+
+
+def main(patterns: list[str]) -> None:
+    conds = dict(zip((5, 1, 3), patterns, strict=True))
+    ks = [k for k in range(100) if all(Path(p.format(k=k)).is_dir() and
+                                        (Path(p.format(k=k)) / "summary.json").exists()
+                                        for p in conds.values())]
+    r = {c: [reading(Path(p.format(k=k))) for k in ks] for c, p in conds.items()}
+    print(f"packings: {ks}\n")
+    print("| condition | depth at 1.9 mm, um (mean, sd/mean) | depth at 12 mm, um (mean, "
+          "sd/mean) | rate over 10-12 mm, um/mm (mean) | time to 12 mm, us |\n"
+          "|---|---|---|---|---|")
+    for c in conds:
+        a = np.array([x["run_in"] for x in r[c]])
+        b = np.array([x["at"] for x in r[c]])
+        late = np.array([x["late"] for x in r[c]])
+        print(f"| {c} | {a.mean() * 1e6:.1f} ({a.std(ddof=1) / a.mean():.0%}) | "
+              f"{b.mean() * 1e6:.1f} ({b.std(ddof=1) / b.mean():.0%}) | "
+              f"{late.mean() * 1e3:.2f} | {r[c][0]['t_at'] * 1e6:.0f} |")
+    print("\n| trend | seed | ours at 1.9 mm (run-in) | ours at 12 mm (saturated) | seed inside "
+          "the 12-mm interval |\n|---|---|---|---|---|")
+    n = len(ks)
+    for name, (c0, seed_pct) in SEED.items():
+        cells = []
+        for key in ("run_in", "at"):
+            a = np.array([x[key] for x in r[c0]])
+            b = np.array([x[key] for x in r[5]])
+            pct, se = change_with_error(a, b, paired=True)
+            cells.append((pct, ci95(se, n)))
+        inside = seed_inside(seed_pct, *cells[1])
+        print(f"| {name} | {seed_pct:+.2f} % | " + " | ".join(
+            f"{p:+.1f} +- {h:.1f} %" for p, h in cells) + f" | {'yes' if inside else 'no'} |")
+    print(f"\n(+- : half-width of the paired 95 % interval over {n} packings, Student t)")
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
