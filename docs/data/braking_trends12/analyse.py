@@ -11,7 +11,9 @@ the rate over the last ``LATE`` of it (is the depth saturated?). Then the paired
 13 -> 21 kN (condition 1 -> 5) and 800 -> 1200 r/min (3 -> 5) with their 95 % intervals
 (``tribodem.braking.compare``, as the sweeps compute them), beside the seed's +24.75 % and
 +16.22 %. Conditions are compared at the same sliding distance (the saturated depth is
-reached in distance, not in time); the time each took is printed. Markdown on stdout.
+reached in distance, not in time); the time each took is printed, and the changes at the
+same time (255 us: 12 mm at 1200 r/min, 8 mm at 800 r/min) beside them, as the seed
+compares its conditions at the same braking time. Markdown on stdout.
 """
 
 from __future__ import annotations
@@ -38,7 +40,8 @@ def reading(d: Path) -> dict[str, float]:
         raise SystemExit(f"{d}: slid {s[-1] * 1e3:.2f} mm, less than {AT * 1e3:.0f} mm")
     m = (s >= AT - LATE) & (s <= AT)
     return {"run_in": float(np.interp(RUN_IN, s, h)), "at": float(np.interp(AT, s, h)),
-            "late": _slope(s[m], h[m]), "t_at": float(np.interp(AT, s, t))}
+            "late": _slope(s[m], h[m]), "t_at": float(np.interp(AT, s, t)),
+            "same_time": float(np.interp(AT / 47.12, t, h))}
 
 
 def main(patterns: list[str]) -> None:
@@ -59,18 +62,19 @@ def main(patterns: list[str]) -> None:
               f"{b.mean() * 1e6:.1f} ({b.std(ddof=1) / b.mean():.0%}) | "
               f"{late.mean() * 1e3:.2f} | {r[c][0]['t_at'] * 1e6:.0f} |")
     print("\n| trend | seed | ours at 1.9 mm (run-in) | ours at 12 mm (saturated) | seed inside "
-          "the 12-mm interval |\n|---|---|---|---|---|")
+          "the 12-mm interval | ours at the same time, 255 us |\n|---|---|---|---|---|---|")
     n = len(ks)
     for name, (c0, seed_pct) in SEED.items():
         cells = []
-        for key in ("run_in", "at"):
+        for key in ("run_in", "at", "same_time"):
             a = np.array([x[key] for x in r[c0]])
             b = np.array([x[key] for x in r[5]])
             pct, se = change_with_error(a, b, paired=True)
             cells.append((pct, ci95(se, n)))
         inside = seed_inside(seed_pct, *cells[1])
-        print(f"| {name} | {seed_pct:+.2f} % | " + " | ".join(
-            f"{p:+.1f} +- {h:.1f} %" for p, h in cells) + f" | {'yes' if inside else 'no'} |")
+        pm = [f"{p:+.1f} +- {h:.1f} %" for p, h in cells]
+        print(f"| {name} | {seed_pct:+.2f} % | {pm[0]} | {pm[1]} | {'yes' if inside else 'no'}"
+              f" | {pm[2]} |")
     print(f"\n(+- : half-width of the paired 95 % interval over {n} packings, Student t)")
 
 
