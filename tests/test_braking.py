@@ -288,6 +288,10 @@ def test_cli_refuses_bad_input(tmp_path: Path) -> None:
     bad.write_text("[condition]\nload_kN = 13.0\n")  # no speed
     r = _cli("run", "--config", str(bad), "--out", str(tmp_path / "z"))
     assert r.returncode == 2 and "speed" in r.stderr
+    bad.write_text("[run]\nduration_s = 1e-5\ndistance_m = 1e-3\n")  # two run lengths
+    r = _cli("run", "--condition", "5", "--config", str(bad), "--out", str(tmp_path / "v"))
+    assert r.returncode == 2 and "distance_m" in r.stderr and "duration_s" in r.stderr
+    assert "Traceback" not in r.stderr and not (tmp_path / "v").exists()
 
 
 def _tiny(change: dict | None = None) -> RunSetup:
@@ -453,3 +457,11 @@ def test_braking_example_configs_resolve() -> None:
     for name in ("braking_steady.toml", "braking_wide.toml"):
         s = setup_from_config(_config(5, root / name, False))
         assert s.until_steady and s.max_distance_m > 0, name
+    # a fixed sliding distance: each condition slides 12 mm at its own speed (table 4)
+    for cond, speed in ((5, 47.12), (3, 31.41)):
+        s = setup_from_config(_config(cond, root / "braking_saturated.toml", False))
+        assert s.duration_s * s.speed_m_s == pytest.approx(12e-3, rel=1e-12)
+        assert s.speed_m_s == pytest.approx(speed, rel=1e-3)
+    # --quick overrides the file's distance (the quick preset's own duration)
+    q = setup_from_config(_config(5, root / "braking_saturated.toml", True))
+    assert q.duration_s == pytest.approx(20e-6)

@@ -80,6 +80,12 @@ class RunCfg(_Strict):
     """Simulated sliding time (s), sampling, numerics."""
 
     duration_s: float = Field(40e-6, gt=0, le=1e-2)
+    distance_m: float = Field(
+        0.0, ge=0, le=0.1,
+        description="slide this distance (m) instead of duration_s: duration = distance / "
+                    "sliding speed, so the conditions of a sweep are compared at the same "
+                    "distance (the closed cell's saturated wear depth, docs/braking.md); 0 = "
+                    "off")
     samples: int = Field(150, ge=2, le=100_000)
     vtk_snapshots: int = Field(6, ge=0, le=10_000)
     micro: Literal["calibrated", "table3"] = "calibrated"
@@ -113,6 +119,12 @@ class RunCfg(_Strict):
         description="samples between checkpoints (checkpoint.npz in the output folder); "
                     "0 = ceil(samples / 10), about every 10% of the run")
 
+    @model_validator(mode="after")
+    def _one_length(self) -> RunCfg:
+        if self.distance_m and "duration_s" in self.model_fields_set:
+            raise ValueError("give duration_s or distance_m, not both")
+        return self
+
 
 class ThermalCfg(_Strict):
     """Optional temperature boundary curve (CSV: time s, temperature K)."""
@@ -133,7 +145,7 @@ class BrakingConfig(_Strict):
 QUICK: dict[str, Any] = {
     "geometry": {"width_m": 144e-6, "disc_height_m": 50e-6, "pad_height_m": 50e-6,
                  "roughness_amplitude_m": 6e-6, "roughness_modes": 3},
-    "run": {"duration_s": 20e-6, "samples": 100, "vtk_snapshots": 4},
+    "run": {"duration_s": 20e-6, "distance_m": 0.0, "samples": 100, "vtk_snapshots": 4},
 }
 
 
@@ -182,7 +194,8 @@ def setup_from_config(cfg: BrakingConfig) -> Any:
         if not curve.is_file():
             raise ConfigError(f"braking: thermal.curve = '{curve}': file does not exist")
     r = cfg.run
-    return RunSetup(pressure_Pa=p, speed_m_s=v, duration_s=r.duration_s, geometry=geo,
+    duration = r.distance_m / v if r.distance_m else r.duration_s
+    return RunSetup(pressure_Pa=p, speed_m_s=v, duration_s=duration, geometry=geo,
                     condition=None if explicit else c.index, micro=r.micro, samples=r.samples,
                     vtk_snapshots=r.vtk_snapshots, wall_mass_ratio=r.wall_mass_ratio,
                     plate_areal_mass=r.plate_areal_mass_kg_m2 or None, backing=r.backing,
