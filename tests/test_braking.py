@@ -465,3 +465,17 @@ def test_braking_example_configs_resolve() -> None:
     # --quick overrides the file's distance (the quick preset's own duration)
     q = setup_from_config(_config(5, root / "braking_saturated.toml", True))
     assert q.duration_s == pytest.approx(20e-6)
+
+
+def test_comparison_says_whether_time_or_distance_was_fixed() -> None:
+    """A sweep at a fixed time says so (the seed's way); one at a fixed distance
+    (``[run] distance_m``, so the times differ with the speed) says that instead."""
+    from tribodem.braking.compare import _length_text
+
+    same_t = {1: {"simulated_time_s": 4e-5, "simulated_sliding_distance_m": 1.885e-3},
+              3: {"simulated_time_s": 4e-5, "simulated_sliding_distance_m": 1.256e-3}}
+    assert "same braking time" in _length_text(same_t, 4e-5)
+    same_d = {1: {"simulated_time_s": 2.55e-4, "simulated_sliding_distance_m": 12e-3},
+              3: {"simulated_time_s": 3.82e-4, "simulated_sliding_distance_m": 12e-3}}
+    text = _length_text(same_d, 2.55e-4)
+    assert "12 mm" in text and "same sliding distance" in text and "255-382 us" in text

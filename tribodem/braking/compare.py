@@ -174,6 +174,21 @@ def _num(x: float) -> float | None:
     return float(x) if x is not None and np.isfinite(x) else None
 
 
+def _length_text(results: dict[int, dict[str, Any]], t_sim: float) -> str:
+    """What the runs simulate: the same time for every condition (the seed's way), or
+    the same sliding distance (``[run] distance_m``: the times differ with the speed)."""
+    times = [float(r["simulated_time_s"]) for r in results.values()]
+    if max(times) - min(times) <= 1e-6 * max(times):
+        return (f"Every run simulates {t_sim * 1e6:.3g} us of sliding (the same braking time "
+                "for all conditions, as the seed compares at 8 s); the seed's 8 s are not "
+                f"simulated (fraction {t_sim / SEED_BRAKING_TIME_S:.2e}).")
+    dist = [float(r["simulated_sliding_distance_m"]) for r in results.values()]
+    return (f"Every run slides {np.mean(dist) * 1e3:.3g} mm (a fixed distance, `[run] "
+            "distance_m`: the conditions are compared at the same sliding distance, not at "
+            f"the same time as the seed does; {min(times) * 1e6:.3g}-{max(times) * 1e6:.3g} us"
+            " of sliding); the seed's 8 s are not simulated.")
+
+
 def write_comparison(out: Path, runs: dict[int, list[tuple[dict[str, Any], Path]]],
                      wall_s: float, cluster: str | int, quick: bool,
                      failed: dict[str, str] | None = None) -> list[tuple[str, str, str]]:
@@ -288,8 +303,9 @@ def write_comparison(out: Path, runs: dict[int, list[tuple[dict[str, Any], Path]
     s5 = series.get(5)
     t_sim = float(next(iter(results.values()))["simulated_time_s"])
     hist = []
+    t5 = float(r5["simulated_time_s"]) if r5 is not None else t_sim  # distance_m: its own
     for ts, hs in SEED_FIG12 if s5 is not None else []:
-        tt = ts / SEED_BRAKING_TIME_S * t_sim
+        tt = ts / SEED_BRAKING_TIME_S * t5
         h = float(np.interp(tt, s5["time_s"], s5["wear_depth_mean_m"]))
         hist.append(f"| {ts:g} | {hs * 1e3:.3g} | {tt * 1e6:.3g} | {h * 1e3:.3g} | "
                     f"{hs / SEED_FIG12[-1][1]:.3f} | "
@@ -343,9 +359,7 @@ def write_comparison(out: Path, runs: dict[int, list[tuple[dict[str, Any], Path]
         f"5 conditions (table 4) x {n_seeds} packing/roughness seed(s) in {wall_s:.0f} s on "
         f"{cluster if isinstance(cluster, str) else f'{cluster} worker processes'}; values "
         "are means over packings +- the standard deviation over "
-        f"seeds. Every run simulates {t_sim * 1e6:.3g} us of sliding (the same braking time "
-        "for all conditions, as the seed compares at 8 s); the seed's 8 s are not "
-        f"simulated (fraction {t_sim / SEED_BRAKING_TIME_S:.2e}). Wear depth = mean pad "
+        f"seeds. {_length_text(results, t_sim)} Wear depth = mean pad "
         "wear depth at the end (worn solid area / (packing fraction x width)); steady wear "
         "rate = wear depth per sliding distance after the run-in (summary.json "
         "`wear_rate_steady_m_per_m`: slope over the last two thirds of the distance); "
