@@ -1,6 +1,7 @@
 """Issue 15: seed 000's two trends asked of the saturated wear depth, not of the run-in.
 
     python docs/data/braking_trends12/analyse.py C5_DIR_PATTERN C1_DIR_PATTERN C3_DIR_PATTERN
+        [--skip K,K,...]
 
 Each pattern holds ``{k}`` for the packing (e.g. ``runs/fixed_p{k}``). The runs are the
 default cell with the 324-um pad (``docs/data/braking_long16/fixed.toml``) of conditions 5
@@ -44,9 +45,9 @@ def reading(d: Path) -> dict[str, float]:
             "same_time": float(np.interp(AT / 47.12, t, h))}
 
 
-def main(patterns: list[str]) -> None:
+def main(patterns: list[str], skip: tuple[int, ...] = ()) -> None:
     conds = dict(zip((5, 1, 3), patterns, strict=True))
-    ks = [k for k in range(100) if all(Path(p.format(k=k)).is_dir() and
+    ks = [k for k in range(100) if k not in skip and all(Path(p.format(k=k)).is_dir() and
                                         (Path(p.format(k=k)) / "summary.json").exists()
                                         for p in conds.values())]
     r = {c: [reading(Path(p.format(k=k))) for k in ks] for c, p in conds.items()}
@@ -79,4 +80,10 @@ def main(patterns: list[str]) -> None:
 
 
 if __name__ == "__main__":
-    main(sys.argv[1:])
+    args = sys.argv[1:]
+    skip: tuple[int, ...] = ()
+    if "--skip" in args:
+        i = args.index("--skip")
+        skip = tuple(int(k) for k in args[i + 1].split(","))
+        del args[i:i + 2]
+    main(args, skip)
