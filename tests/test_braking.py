@@ -479,3 +479,25 @@ def test_comparison_says_whether_time_or_distance_was_fixed() -> None:
               3: {"simulated_time_s": 3.82e-4, "simulated_sliding_distance_m": 12e-3}}
     text = _length_text(same_d, 2.55e-4)
     assert "12 mm" in text and "same sliding distance" in text and "255-382 us" in text
+
+
+def test_fixed_distance_run_through_the_installed_command(tmp_path: Path) -> None:
+    """``[run] distance_m``: the installed command slides that distance at the condition's
+    speed (condition 3: 31.41 m/s), the resolved config keeps it, and the run resumes."""
+    from conftest import run_tribodem
+
+    cfg = tmp_path / "d.toml"
+    cfg.write_text("[geometry]\nwidth_m = 144e-6\ndisc_height_m = 50e-6\npad_height_m = 50e-6\n"
+                   "roughness_amplitude_m = 6e-6\nroughness_modes = 3\n"
+                   "[run]\ndistance_m = 0.2e-3\nsamples = 20\nvtk_snapshots = 0\n"
+                   "figures = false\n")
+    out = tmp_path / "run"
+    r = run_tribodem("braking", "run", "--condition", "3", "--config", str(cfg), "--out",
+                     str(out), "--no-progress")
+    assert r.returncode == 0, r.stderr[-800:]
+    s = json.loads((out / "summary.json").read_text())
+    assert s["simulated_sliding_distance_m"] == pytest.approx(0.2e-3, rel=2e-3)
+    assert s["simulated_time_s"] == pytest.approx(0.2e-3 / s["sliding_speed_m_s"], rel=2e-3)
+    assert "distance_m = 0.0002" in (out / "config.toml").read_text()
+    r = run_tribodem("braking", "run", "--out", str(out), "--resume", "--no-progress")
+    assert r.returncode == 0 and "already finished" in r.stderr, r.stderr[-800:]

@@ -85,7 +85,7 @@ class RunCfg(_Strict):
         description="slide this distance (m) instead of duration_s: duration = distance / "
                     "sliding speed, so the conditions of a sweep are compared at the same "
                     "distance (the closed cell's saturated wear depth, docs/braking.md); 0 = "
-                    "off")
+                    "off; not with duration_s in the same file")
     samples: int = Field(150, ge=2, le=100_000)
     vtk_snapshots: int = Field(6, ge=0, le=10_000)
     micro: Literal["calibrated", "table3"] = "calibrated"
@@ -118,12 +118,6 @@ class RunCfg(_Strict):
         0, ge=0, le=100_000,
         description="samples between checkpoints (checkpoint.npz in the output folder); "
                     "0 = ceil(samples / 10), about every 10% of the run")
-
-    @model_validator(mode="after")
-    def _one_length(self) -> RunCfg:
-        if self.distance_m and "duration_s" in self.model_fields_set:
-            raise ValueError("give duration_s or distance_m, not both")
-        return self
 
 
 class ThermalCfg(_Strict):
@@ -224,6 +218,11 @@ def _config(condition: int | None, config: Path | None, quick: bool,
     preset <- ``--condition``."""
     if config is not None:
         data, source = load_toml(config), str(config)
+        run = data.get("run", {}) if isinstance(data.get("run"), dict) else {}
+        if "duration_s" in run and run.get("distance_m"):
+            raise ConfigError(f"{source}: field 'run.duration_s' = {run['duration_s']!r} and "
+                              f"'run.distance_m' = {run['distance_m']!r}: give one run length "
+                              "(distance_m replaces duration_s)")
     else:
         data = base or {}
     if quick:
