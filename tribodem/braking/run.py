@@ -269,6 +269,8 @@ def _slope(x: np.ndarray, y: np.ndarray) -> float:
 #: ten 16-mm runs: the test alone passed in 9, at 3-14 mm, reporting rates 0.3-74x those
 #: of the runs' second halves; with the cuts it passed in none)
 STEADY_CUTS = (1.0, 0.9, 0.8)
+#: ``until_steady`` slides on in blocks of this fraction of ``duration_s`` between tests
+STEADY_BLOCK = 0.2
 
 
 def _thirds(s: np.ndarray, h: np.ndarray, tol: float) -> tuple[bool, float, float]:
@@ -497,7 +499,7 @@ def run_braking(setup: RunSetup, out: Path | None = None, *, resume: bool = Fals
 
     def slid_now() -> float:
         return loop.distance if speed_steps else setup.speed_m_s * (sim.time - t0)
-    block = max(1, int(math.ceil(0.2 * min_steps)))
+    block = max(1, int(math.ceil(STEADY_BLOCK * min_steps)))
     ended = False
     every = max(1, total_steps // max(1, setup.samples))
     ck_every = checkpoint_interval(setup)

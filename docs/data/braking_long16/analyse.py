@@ -18,12 +18,14 @@ from pathlib import Path
 
 import numpy as np
 
+from tribodem.braking.cli import RunCfg
 from tribodem.braking.compare import _series  # the sweep comparison's timeseries reader
-from tribodem.braking.run import STEADY_CUTS, _slope, steady_state
+from tribodem.braking.run import STEADY_BLOCK, STEADY_CUTS, _slope, steady_state
 
 WINDOW = 2.0e-3  # m of sliding per window
 #: ``until_steady`` as the default run does it: first test after 40 us, then every 8 us
-FIRST_S, BLOCK_S = 40e-6, 8e-6
+FIRST_S = RunCfg().duration_s
+BLOCK_S = STEADY_BLOCK * FIRST_S
 
 
 def first_pass(ts: dict[str, np.ndarray], cuts: tuple[float, ...],

@@ -24,13 +24,24 @@ from pathlib import Path
 
 import numpy as np
 
-from tribodem.braking.compare import _series, change_with_error, ci95, seed_inside
+from tribodem.braking.cli import RunCfg
+from tribodem.braking.compare import (
+    SEED_CHANGES,
+    _series,
+    change_with_error,
+    ci95,
+    seed_inside,
+)
+from tribodem.braking.conditions import get_condition
 from tribodem.braking.run import _slope
 
 AT = 12.0e-3  # m slid: where the depth is compared
-RUN_IN = 1.885e-3  # m: the seed's 40 us at 47.12 m/s
+V5 = get_condition(5).speed_m_s  # m/s: condition 5 (1200 r/min)
+RUN_IN = RunCfg().duration_s * V5  # m: the seed's 40 us at condition 5's speed (1.9 mm)
 LATE = 2.0e-3  # m: the window of the late rate
-SEED = {"13 -> 21 kN (1 -> 5)": (1, 24.75), "800 -> 1200 r/min (3 -> 5)": (3, 16.22)}
+#: the seed's two end-to-end changes (label, from condition, %) to condition 5
+SEED = {f"{name} ({a} -> {b})": (a, pct) for name, a, b, pct, _ in SEED_CHANGES
+        if (a, b) in ((1, 5), (3, 5))}
 
 
 def reading(d: Path) -> dict[str, float]:
@@ -42,7 +53,7 @@ def reading(d: Path) -> dict[str, float]:
     m = (s >= AT - LATE) & (s <= AT)
     return {"run_in": float(np.interp(RUN_IN, s, h)), "at": float(np.interp(AT, s, h)),
             "late": _slope(s[m], h[m]), "t_at": float(np.interp(AT, s, t)),
-            "same_time": float(np.interp(AT / 47.12, t, h))}
+            "same_time": float(np.interp(AT / V5, t, h))}
 
 
 def main(patterns: list[str], skip: tuple[int, ...] = ()) -> None:
