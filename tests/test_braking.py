@@ -26,7 +26,7 @@ from tribodem.braking.conditions import (
     rpm_to_speed,
     speed_to_rpm,
 )
-from tribodem.braking.measure import classify, measure, reference
+from tribodem.braking.measure import classify, measure, reference, spanning
 from tribodem.braking.model import (
     DISC,
     LOOSE_MAX,
@@ -41,6 +41,7 @@ from tribodem.braking.model import (
     start_sliding,
 )
 from tribodem.braking.run import RunSetup, run_braking, wear_extrapolation
+from tribodem.dem.bonds import TENSILE
 from tribodem.dem.state import FIX_X, FIX_Y
 
 SMALL = Geometry(width=100e-6, disc_height=36e-6, pad_height=36e-6, amplitude=4e-6, modes=2,
@@ -159,6 +160,55 @@ def _pad_vibration(backing: str, steps: int) -> float:
     v, m = p.vel[pad], p.mass[pad]
     vm = (m[:, None] * v).sum(0) / m.sum()
     return 0.5 * float((m[:, None] * (v - vm) ** 2).sum())
+
+
+def test_spanning_intervals_round_the_periodic_cell() -> None:
+    """A component spans the cell when its x-extents leave no gap of a diameter, the
+    gap round x = W counted."""
+    w = 10.0
+    x = np.arange(10) + 0.5 + 0.3  # radius 0.5: touching disks, the row crossing x = W
+    r = np.full(10, 0.5)
+    lab = np.zeros(10, dtype=int)
+    assert spanning(x, r, lab, w, np.array([0]))[0]
+    x2 = x.copy()
+    x2[4] += 0.95  # a gap of 0.95 < one diameter: still spans
+    assert spanning(x2, r, lab, w, np.array([0]))[0]
+    assert not spanning(x[:-1], r[:-1], lab[:-1], w, np.array([0]))[0]  # gap of 1.0
+    assert not spanning(x, r, lab, w, np.array([], dtype=int))[0]  # not a candidate
+
+
+def test_a_slab_as_wide_as_the_cell_is_delamination_not_wear() -> None:
+    """Cut every pad bond crossing the pad's mid-plane and move the freed slab by 3 mean
+    radii: it spans the cell, so it is reported as delaminated and the wear depth stays
+    0. Cut the slab across at x = W/4 and 3W/4 as well: its two halves are debris and
+    the wear depth is their solid area over phi W (module measure's definition)."""
+    it = build_interface(SMALL, 0.33e6)
+    p, b = it.sim.p, it.bonds
+    ref = reference(it)
+    pad = p.group == PAD
+    below = pad & (p.pos[:, 1] < np.median(p.pos[pad, 1]))
+    inpad = p.group[b.i] == PAD
+    b.mode[inpad & (below[b.i] != below[b.j])] = TENSILE
+    matrix, _ = classify(it)
+    slab = pad & ~matrix
+    assert slab.sum() > 0.3 * pad.sum()
+    p.pos[slab, 1] -= 3.0 * float(p.radius.mean())
+    m = measure(it, ref, 0.0)
+    assert m["delaminated_particles_pad"] == slab.sum()
+    assert m["worn_particles_pad"] == 0 and m["wear_depth_mean_pad_m"] == 0.0
+    area = float((np.pi * p.radius[slab] ** 2).sum())
+    assert m["delaminated_depth_pad_m"] == pytest.approx(area / (it.phi[PAD] * it.width),
+                                                         rel=1e-12)
+    w = it.width
+    xm = np.mod(p.pos[:, 0], w)
+    for xc in (0.25 * w, 0.75 * w):
+        left = xm < xc
+        crosses = (left[b.i] != left[b.j]) & (np.abs(xm[b.i] - xm[b.j]) < 0.5 * w)
+        b.mode[inpad & crosses] = TENSILE
+    m = measure(it, ref, 0.0)
+    assert m["delaminated_particles_pad"] == 0
+    assert m["worn_particles_pad"] == slab.sum()
+    assert m["wear_depth_mean_pad_m"] == pytest.approx(area / (it.phi[PAD] * w), rel=1e-12)
 
 
 def test_absorbing_backing_lets_waves_leave_the_pad() -> None:

@@ -4,11 +4,21 @@ Definitions (reference state = the loaded interface at the start of sliding):
 
 - **matrix / debris**: the graph of intact bonds is split into connected components
   (scipy.sparse.csgraph); a component holding an anchored particle (disc bottom layer,
-  pad top layer) is the body's *matrix*; every other particle is *detached* = *debris*.
-  Each particle is exactly one of the two. *Debris clusters* are the debris components
+  pad top layer) is the body's *matrix*; every other particle is *detached*: *debris*,
+  or part of a delaminated layer (below). Each particle is exactly one of the three.
+  *Debris clusters* are the debris components
   (a lone particle is a cluster of one; ``debris_clusters_multi`` counts those of >= 2).
   Bonds never re-form, so detachment is irreversible.
-- **worn** particles: detached particles displaced by more than one mean radius from
+- **delaminated layer**: a detached component that spans the periodic cell (its
+  particles' x-extents leave no gap as wide as one particle diameter): a crack that ran
+  parallel to the surface through the whole cell and freed a slab as wide as the cell.
+  Such a slab cannot leave the interface; it carries the load between the bodies and is
+  worn on from its free face. Its size is set by the cell width, not by the wear process
+  (in a real pad a subsurface crack meets the pad's edge or arrests), so it is reported
+  on its own (``delaminated_particles_*``, ``delaminated_depth_*_m``) and counted neither
+  as debris nor as wear; once it breaks into pieces narrower than the cell they are
+  debris again. Cells whose bodies never crack through are unaffected.
+- **worn** particles: debris particles displaced by more than one mean radius from
   their place in their body's frame (the disc's rigid sliding removed): material that
   left the surface, not a cracked grain still in its seat.
 - **wear depth, mean** (per body): the solid area of the body's worn particles over
@@ -98,6 +108,36 @@ def classify(iface: Interface) -> tuple[np.ndarray, np.ndarray]:
     return anchored[lab], lab
 
 
+def spanning(x: np.ndarray, radius: np.ndarray, lab: np.ndarray, width: float,
+             candidates: np.ndarray) -> np.ndarray:
+    """Mask over component labels: True where the component (one of ``candidates``)
+    spans the periodic cell of width ``width`` (m): the union of its particles' x-extents
+    ``[x - r, x + r]`` leaves no gap (round the cell) as wide as one of its mean
+    particle diameters."""
+    out = np.zeros(int(lab.max()) + 1, dtype=bool)
+    for c in candidates:
+        m = lab == c
+        lo = np.mod(x[m] - radius[m], width)
+        o = np.argsort(lo)
+        lo = lo[o]
+        hi = lo + 2.0 * radius[m][o]
+        reach = np.maximum.accumulate(hi)  # right end of the union of intervals 0..k
+        gaps = np.append(lo[1:] - reach[:-1], lo[0] + width - reach[-1])
+        out[c] = gaps.max() < 2.0 * float(radius[m].mean())
+    return out
+
+
+def layers(iface: Interface, matrix: np.ndarray, lab: np.ndarray) -> np.ndarray:
+    """Mask of the particles in a delaminated layer (module docstring): detached
+    components spanning the periodic cell."""
+    p = iface.sim.p
+    w = iface.width
+    sizes = np.bincount(lab[~matrix], minlength=int(lab.max()) + 1)
+    # fewer particles than this cannot span the cell with gaps under one diameter
+    cand = np.flatnonzero(sizes >= w / (4.0 * float(p.radius.max())))
+    return spanning(p.pos[:, 0], p.radius, lab, w, cand)[lab] & ~matrix
+
+
 def force_chains(iface: Interface) -> dict[str, np.ndarray]:
     """Pairs carrying force (contacts + intact bonds, summed per pair): i, j, normal force
     (N, + compression)."""
@@ -121,7 +161,8 @@ def measure(iface: Interface, ref: Reference, slid: float) -> dict[str, float]:
     sliding distance since the reference (m). SI units."""
     p = iface.sim.p
     matrix, lab = classify(iface)
-    debris = ~matrix
+    layer = layers(iface, matrix, lab)
+    debris = ~matrix & ~layer
     u = p.pos - ref.pos
     u[ref.group == DISC, 0] += slid
     u[:, 0] -= ref.width * np.rint(u[:, 0] / ref.width)
@@ -133,6 +174,9 @@ def measure(iface: Interface, ref: Reference, slid: float) -> dict[str, float]:
         d = worn & (ref.group == body)
         out[f"worn_particles_{name}"] = float(d.sum())
         out[f"debris_particles_{name}"] = float((debris & (ref.group == body)).sum())
+        lay = layer & (ref.group == body)
+        out[f"delaminated_particles_{name}"] = float(lay.sum())
+        out[f"delaminated_depth_{name}_m"] = float(area[lay].sum() / (ref.phi[body] * w))
         out[f"wear_depth_mean_{name}_m"] = float(area[d].sum() / (ref.phi[body] * w))
         dep = ref.depth(np.flatnonzero(d), edge=True)
         out[f"wear_depth_max_{name}_m"] = float(max(0.0, dep.max(initial=0.0)))
