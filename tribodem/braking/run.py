@@ -690,7 +690,9 @@ def run_braking(setup: RunSetup, out: Path | None = None, *, resume: bool = Fals
             "debris_clusters_multi", "matrix_particles", "force_chains",
             "strong_force_chains", "weak_force_chains", "tensile_force_chains",
             "compressive_force_chains", "transfer_layer_thickness_m", "wear_range_disc_m",
-            "wear_range_pad_m", "wear_range_ratio", "debris_max_vertical_displacement_m")},
+            "wear_range_pad_m", "wear_range_ratio", "debris_max_vertical_displacement_m",
+            "delaminated_particles_pad", "delaminated_depth_pad_m",
+            "delaminated_particles_disc", "delaminated_depth_disc_m")},
         "steady_wear_rate_m_s": rate,
         "wear_rate_steady_m_per_m": st["rate"],
         "wear_rate_middle_third_m_per_m": st["rate_mid"],
@@ -790,6 +792,15 @@ def _outcome_notes(summary: dict[str, Any]) -> list[str]:
             "cell is narrower than the pad's load-sharing length), so the wear rates average "
             "contact episodes, not a closed sliding contact; wider cells ([geometry] "
             "width_m) close it (docs/braking.md)")
+    for body in ("pad", "disc"):
+        if summary.get(f"delaminated_particles_{body}", 0) > 0:
+            notes.append(
+                f"the {body} cracked through parallel to its surface: a slab as wide as the "
+                f"cell ({summary[f'delaminated_particles_{body}']:.0f} particles, "
+                f"{1e6 * summary[f'delaminated_depth_{body}_m']:.1f} um of intact material) "
+                "is detached but spans the periodic cell, so it is reported as delaminated, "
+                "not as debris or wear (its size is the cell's; docs/braking.md "
+                "'Measurements')")
     if not summary["steady_reached"]:
         notes.append(
             "steady-state rule not passed within the distance slid: "

@@ -3,7 +3,8 @@
     python docs/data/braking_trends12/analyse.py C5_DIR_PATTERN C1_DIR_PATTERN C3_DIR_PATTERN
         [--skip K,K,...]
 
-Each pattern holds ``{k}`` for the packing (e.g. ``runs/fixed_p{k}``). The runs are the
+Each pattern holds ``{k}`` for the packing (e.g. ``runs/fixed_p{k}``); ``A|B`` takes the
+first of A, B that holds a finished run for packing k. The runs are the
 default cell with the 324-um pad (``docs/data/braking_long16/fixed.toml``) of conditions 5
 (21 kN, 1200 r/min), 1 (13 kN, 1200 r/min) and 3 (21 kN, 800 r/min) on the same packings
 (``[geometry] seed`` K), slid at least ``AT`` (12 mm). Per packing and condition: the pad's
@@ -56,12 +57,20 @@ def reading(d: Path) -> dict[str, float]:
             "same_time": float(np.interp(AT / V5, t, h))}
 
 
+def run_dir(pattern: str, k: int) -> Path | None:
+    """The first alternative of ``pattern`` (``A|B``) with a finished run for packing k."""
+    for alt in pattern.split("|"):
+        d = Path(alt.format(k=k))
+        if (d / "summary.json").exists():
+            return d
+    return None
+
+
 def main(patterns: list[str], skip: tuple[int, ...] = ()) -> None:
     conds = dict(zip((5, 1, 3), patterns, strict=True))
-    ks = [k for k in range(100) if k not in skip and all(Path(p.format(k=k)).is_dir() and
-                                        (Path(p.format(k=k)) / "summary.json").exists()
-                                        for p in conds.values())]
-    r = {c: [reading(Path(p.format(k=k))) for k in ks] for c, p in conds.items()}
+    ks = [k for k in range(100) if k not in skip and all(run_dir(p, k) is not None
+                                                         for p in conds.values())]
+    r = {c: [reading(run_dir(p, k)) for k in ks] for c, p in conds.items()}
     print(f"packings: {ks}\n")
     print("| condition | depth at 1.9 mm, um (mean, sd/mean) | depth at 12 mm, um (mean, "
           "sd/mean) | rate over 10-12 mm, um/mm (mean) | time to 12 mm, us |\n"
