@@ -208,6 +208,34 @@ def test_local_sweep_comparison_has_paired_intervals(local: Path) -> None:
     assert "paired 95% interval" in md and "seed inside" in md
 
 
+def test_sweep_of_chosen_conditions_reuses_members_and_evaluates_what_it_can(
+        local: Path, tmp_path: Path) -> None:
+    """``--conditions 1,5`` on a copy of the 2-packing sweep: its members are the same
+    folders (skipped as finished, nothing run), and only the change 1 -> 5 is evaluated."""
+    import shutil
+
+    out = tmp_path / "C"
+    shutil.copytree(local, out)
+    for f in ("comparison.md", "comparison.json", "comparison.csv"):
+        (out / f).unlink()
+    r = run_tribodem("braking", "sweep", "--config", str(local.parent / "sweep.toml"),
+                     "--out", str(out), "--packings", "2", "--conditions", "5,1",
+                     "--workers", "2", "--no-progress", timeout=300)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.count("finished earlier, skipped") == 4
+    assert "condition(s) 1,5 x 2 packing(s)" in r.stdout
+    j = json.loads((out / "comparison.json").read_text())
+    assert j["conditions"] == {"1": 2, "5": 2}
+    full = json.loads((local / "comparison.json").read_text())
+    for t, u in zip(j["trends"], full["trends"], strict=True):
+        if (t["from_condition"], t["to_condition"]) == (1, 5):
+            assert t == u  # the same members, the same paired change
+        else:
+            assert t["ours_pct"] is None and t["reproduced"] is None
+    assert "Condition(s) 1, 5 of table 4 (not run or all failed: 2, 3, 4)" in (
+        out / "comparison.md").read_text()
+
+
 def test_sweep_options_refused_before_any_work(config: Path, tmp_path: Path) -> None:
     out = tmp_path / "X"
     r = run_tribodem("braking", "sweep", "--config", str(config), "--out", str(out),
@@ -219,6 +247,11 @@ def test_sweep_options_refused_before_any_work(config: Path, tmp_path: Path) -> 
     r = run_tribodem("braking", "sweep", "--config", str(config), "--out", str(out),
                      "--seeds", "2", "--packings", "3", timeout=120)
     assert r.returncode == 2 and "deprecated" in r.stderr and "--packings" in r.stderr
+    for bad in ("1,6", "1,1", "one"):
+        r = run_tribodem("braking", "sweep", "--config", str(config), "--out", str(out),
+                         "--conditions", bad, timeout=120)
+        assert r.returncode == 2 and "--conditions" in r.stderr and bad in r.stderr
+        assert "[1, 2, 3, 4, 5]" in r.stderr and "Traceback" not in r.stderr
     assert not out.exists()
     r = run_tribodem("braking", "sweep", "--help", timeout=120)
     assert "--packings" in r.stdout and "--seeds" not in r.stdout

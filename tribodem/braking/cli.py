@@ -350,17 +350,34 @@ def braking_run(
     typer.echo(json.dumps({k: summary[k] for k in _SHOWN}, indent=2))
 
 
-def _members(base: dict[str, Any], packings: int, out: Path) -> list[Any]:
+def _conditions(text: str) -> list[int]:
+    """``--conditions`` ("1,3,5") -> sorted condition numbers (ConfigError: exit 2)."""
+    from tribodem.braking.conditions import CONDITIONS
+
+    allowed = f"a comma-separated subset of {sorted(CONDITIONS)} (seed 000 table 4)"
+    try:
+        ks = [int(x) for x in text.split(",")]
+    except ValueError:
+        raise ConfigError(f"braking sweep: --conditions = {text!r}; allowed: {allowed}"
+                          ) from None
+    if not ks or any(k not in CONDITIONS for k in ks) or len(set(ks)) != len(ks):
+        raise ConfigError(f"braking sweep: --conditions = {text!r}; allowed: {allowed}, "
+                          "each once")
+    return sorted(ks)
+
+
+def _members(base: dict[str, Any], packings: int, out: Path,
+             conditions: list[int] | None = None) -> list[Any]:
     """The sweep's members, each config checked (ConfigError) before anything is made.
     Folders: ``condition_k`` with one packing, else ``condition_k/seed_s`` (packing s,
     geometry seed ``seed + s``; the folder name is kept from the former ``--seeds``, so
-    earlier sweeps are skipped/resumed, not redone)."""
+    earlier sweeps are skipped/resumed, not redone). ``conditions``: default 1-5."""
     from tribodem.braking.ensemble import Member
 
     seed0 = int(base["geometry"]["seed"])
     members = []
     for s in range(packings):
-        for k in range(1, 6):
+        for k in conditions or range(1, 6):
             data = merge(base, {"condition": {"index": k}, "geometry": {"seed": seed0 + s}})
             setup_from_config(validate(BrakingConfig, data, source="sweep"))
             d = out / f"condition_{k}" if packings == 1 else out / f"condition_{k}" / f"seed_{s}"
@@ -381,6 +398,11 @@ def braking_sweep(
              "...); changes are paired over them. Default 1."),
     seeds: int | None = typer.Option(None, "--seeds", min=1, max=1000, hidden=True,
                                      help="Deprecated alias of --packings."),
+    conditions: str = typer.Option(
+        "1,2,3,4,5", "--conditions",
+        help="Which conditions of table 4 to run, e.g. 1,3,5 (the two end-to-end trends, "
+             "13 -> 21 kN and 800 -> 1200 r/min, at 3/5 of the cost); changes needing an "
+             "absent condition are left unevaluated."),
     workers: int = typer.Option(
         0, "--workers", min=0, max=1024,
         help="Worker processes of the local Dask cluster (1 thread each); 0 = all local "
@@ -394,8 +416,8 @@ def braking_sweep(
                                   help="Progress bar (members done / running / failed) on "
                                        "stderr."),
 ) -> None:
-    """Conditions 1-5 x --packings on Dask: comparison.md, comparison.json, comparison.csv
-    (ours with paired 95% intervals beside the seed's).
+    """Conditions 1-5 (or --conditions) x --packings on Dask: comparison.md,
+    comparison.json, comparison.csv (ours with paired 95% intervals beside the seed's).
 
     Each (condition, packing) member is an independent, idempotent task with its own
     folder and checkpoints; a re-run with the same --out skips the finished members,
@@ -417,10 +439,11 @@ def braking_sweep(
                               "give --packings only")
     n_pack = packings or seeds or 1
     check_cluster_options("braking sweep", workers, scheduler)
+    conds = _conditions(conditions)
     base = _config(None, config, quick).model_dump()
     base["condition"] = {}
     t0 = time.perf_counter()
-    members = _members(base, n_pack, out)
+    members = _members(base, n_pack, out, conds)
     runs.check_out_dir(out, "--out")  # every member checked first: no folder for a bad one
     runs.announce(out)
     results: dict[tuple[int, int], dict[str, Any]] = {}
@@ -460,7 +483,8 @@ def braking_sweep(
     rows = write_comparison(out, runs_by_k, wall, where, quick, failed=fails) \
         if runs_by_k else []
     skipped = len(members) - len(todo)
-    typer.echo(f"sweep: 5 conditions x {n_pack} packing(s) in {wall:.1f} s on {where} "
+    typer.echo(f"sweep: condition(s) {','.join(map(str, conds))} x {n_pack} packing(s) "
+               f"in {wall:.1f} s on {where} "
                f"({len(todo)} run, {skipped} skipped as finished, {len(failed)} failed) "
                f"-> {out / 'comparison.md'}")
     for r in rows:

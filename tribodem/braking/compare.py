@@ -350,13 +350,15 @@ def write_comparison(out: Path, runs: dict[int, list[tuple[dict[str, Any], Path]
         f"0): {r5['wear_depth_mean_extrapolated_8s_m'] * 1e3:.3g} mm "
         f"(rate {r5['steady_wear_rate_m_s']:.3g} m/s) vs the seed's 7.69e-2 mm: an "
         "extrapolation over ~6 orders of magnitude in time, not a result."
-        if r5 is not None else "Condition 5 has no run (failed): no history.")
+        if r5 is not None else "Condition 5 has no run (not run or failed): no history.")
     fail_lines = ["## Failed members", "", "Left out of every mean and change above:", "",
                   *[f"- {m}: {e}" for m, e in failed.items()], ""] if failed else []
     text = "\n".join([
         "# Braking sweep: tribodem vs seed 000" + (" (--quick)" if quick else ""),
         "",
-        f"5 conditions (table 4) x {n_seeds} packing/roughness seed(s) in {wall_s:.0f} s on "
+        f"Condition(s) {', '.join(map(str, sorted(runs)))} of table 4"
+        + (f" (not run or all failed: {', '.join(map(str, missing))})" if missing else "")
+        + f" x {n_seeds} packing/roughness seed(s) in {wall_s:.0f} s on "
         f"{cluster if isinstance(cluster, str) else f'{cluster} worker processes'}; values "
         "are means over packings +- the standard deviation over "
         f"seeds. {_length_text(results, t_sim)} Wear depth = mean pad "
