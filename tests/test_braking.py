@@ -175,6 +175,13 @@ def test_spanning_intervals_round_the_periodic_cell() -> None:
     assert spanning(x2, r, lab, w, np.array([0]))[0]
     assert not spanning(x[:-1], r[:-1], lab[:-1], w, np.array([0]))[0]  # gap of 1.0
     assert not spanning(x, r, lab, w, np.array([], dtype=int))[0]  # not a candidate
+    # a large disk round x = 0 ([8.9, 12.1] = [8.9, W) + [0, 2.1)) bridges the 1.5 gap
+    # between the small disk [0.2, 0.5] and the row [2, 9]: it spans; without it, not
+    x3 = np.array([0.35, 2.5, 3.5, 4.5, 5.5, 6.5, 7.5, 8.5, 0.5])
+    r3 = np.array([0.15, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 1.6])
+    lab3 = np.zeros(9, dtype=int)
+    assert spanning(x3, r3, lab3, w, np.array([0]))[0]
+    assert not spanning(x3[:-1], r3[:-1], lab3[:-1], w, np.array([0]))[0]
 
 
 def test_a_slab_as_wide_as_the_cell_is_delamination_not_wear() -> None:

@@ -121,8 +121,11 @@ def spanning(x: np.ndarray, radius: np.ndarray, lab: np.ndarray, width: float,
         o = np.argsort(lo)
         lo = lo[o]
         hi = lo + 2.0 * radius[m][o]
-        reach = np.maximum.accumulate(hi)  # right end of the union of intervals 0..k
-        gaps = np.append(lo[1:] - reach[:-1], lo[0] + width - reach[-1])
+        n = lo.size
+        # two turns round the cell, so an interval that wraps past x = W covers the start
+        lo2, hi2 = np.concatenate([lo, lo + width]), np.concatenate([hi, hi + width])
+        reach = np.maximum.accumulate(hi2)  # right end of the union of intervals 0..k
+        gaps = lo2[n:] - reach[n - 1:2 * n - 1]  # before each start of the second turn
         out[c] = gaps.max() < 2.0 * float(radius[m].mean())
     return out
 
