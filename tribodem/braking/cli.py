@@ -33,7 +33,14 @@ from typing import Any, Literal
 import typer
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
-from tribodem.io.config import ConfigError, dump_toml, load_toml, merge, validate
+from tribodem.io.config import (
+    ConfigError,
+    dump_toml,
+    load_toml,
+    merge,
+    parse_int_list,
+    validate,
+)
 from tribodem.io.results import write_text
 
 braking_app = typer.Typer(help="Braking interface wear model (seed 000).", no_args_is_help=True)
@@ -350,34 +357,31 @@ def braking_run(
     typer.echo(json.dumps({k: summary[k] for k in _SHOWN}, indent=2))
 
 
-def _conditions(text: str) -> list[int]:
-    """``--conditions`` ("1,3,5") -> sorted condition numbers (ConfigError: exit 2)."""
+def _conditions(text: str | None) -> list[int]:
+    """``--conditions`` ("1,3,5"; None: all) -> sorted condition numbers (ConfigError:
+    exit 2)."""
     from tribodem.braking.conditions import CONDITIONS
 
-    allowed = f"a comma-separated subset of {sorted(CONDITIONS)} (seed 000 table 4)"
-    try:
-        ks = [int(x) for x in text.split(",")]
-    except ValueError:
-        raise ConfigError(f"braking sweep: --conditions = {text!r}; allowed: {allowed}"
-                          ) from None
-    if not ks or any(k not in CONDITIONS for k in ks) or len(set(ks)) != len(ks):
-        raise ConfigError(f"braking sweep: --conditions = {text!r}; allowed: {allowed}, "
-                          "each once")
-    return sorted(ks)
+    if text is None:
+        return sorted(CONDITIONS)
+    return sorted(parse_int_list(
+        text, "braking sweep: --conditions", lambda k: k in CONDITIONS,
+        f"distinct comma-separated conditions of {sorted(CONDITIONS)} (seed 000 table 4), "
+        "e.g. 1,3,5"))
 
 
 def _members(base: dict[str, Any], packings: int, out: Path,
-             conditions: list[int] | None = None) -> list[Any]:
+             conditions: list[int]) -> list[Any]:
     """The sweep's members, each config checked (ConfigError) before anything is made.
     Folders: ``condition_k`` with one packing, else ``condition_k/seed_s`` (packing s,
     geometry seed ``seed + s``; the folder name is kept from the former ``--seeds``, so
-    earlier sweeps are skipped/resumed, not redone). ``conditions``: default 1-5."""
+    earlier sweeps are skipped/resumed, not redone); ``conditions`` of table 4."""
     from tribodem.braking.ensemble import Member
 
     seed0 = int(base["geometry"]["seed"])
     members = []
     for s in range(packings):
-        for k in conditions or range(1, 6):
+        for k in conditions:
             data = merge(base, {"condition": {"index": k}, "geometry": {"seed": seed0 + s}})
             setup_from_config(validate(BrakingConfig, data, source="sweep"))
             d = out / f"condition_{k}" if packings == 1 else out / f"condition_{k}" / f"seed_{s}"
@@ -398,11 +402,11 @@ def braking_sweep(
              "...); changes are paired over them. Default 1."),
     seeds: int | None = typer.Option(None, "--seeds", min=1, max=1000, hidden=True,
                                      help="Deprecated alias of --packings."),
-    conditions: str = typer.Option(
-        "1,2,3,4,5", "--conditions",
+    conditions: str | None = typer.Option(
+        None, "--conditions",
         help="Which conditions of table 4 to run, e.g. 1,3,5 (the two end-to-end trends, "
              "13 -> 21 kN and 800 -> 1200 r/min, at 3/5 of the cost); changes needing an "
-             "absent condition are left unevaluated."),
+             "absent condition are left unevaluated. Default: all five."),
     workers: int = typer.Option(
         0, "--workers", min=0, max=1024,
         help="Worker processes of the local Dask cluster (1 thread each); 0 = all local "

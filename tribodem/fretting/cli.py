@@ -63,7 +63,14 @@ from tribodem.fretting.output import (
     write_vtk_surfaces,
 )
 from tribodem.io import runs
-from tribodem.io.config import ConfigError, dump_toml, load_toml, merge, validate
+from tribodem.io.config import (
+    ConfigError,
+    dump_toml,
+    load_toml,
+    merge,
+    parse_int_list,
+    validate,
+)
 from tribodem.io.results import write_text
 from tribodem.materials.en24t import EN24T
 
@@ -1066,15 +1073,9 @@ QUICK_STUDY_COUNTS = "1100,4050,5100"
 
 def parse_counts(text: str, field: str = "--counts") -> tuple[int, ...]:
     """Comma-separated particle counts (each 1..10^7, distinct, in any order)."""
-    try:
-        counts = tuple(int(v) for v in text.replace(" ", "").split(","))
-    except ValueError:
-        counts = ()
-    if not counts or any(not 1 <= c <= 10**7 for c in counts) or len(set(counts)) < len(
-            counts):
-        raise ConfigError(f"{field} = {text!r}: allowed: comma-separated distinct particle "
-                          "counts, each 1..10000000 (e.g. 22000,81000,102000)")
-    return counts
+    return parse_int_list(text, field, lambda c: 1 <= c <= 10**7,
+                          "comma-separated distinct particle counts, each 1..10000000 "
+                          "(e.g. 22000,81000,102000)")
 
 
 @fretting_app.command("study")

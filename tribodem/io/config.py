@@ -7,6 +7,7 @@ and what is allowed (``ConfigError``; the CLI turns it into exit code 2, no trac
 from __future__ import annotations
 
 import tomllib
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any, TypeVar
 
@@ -42,6 +43,19 @@ def validate(model: type[M], data: dict[str, Any], source: str = "config") -> M:
         return model.model_validate(data)
     except ValidationError as err:
         raise ConfigError(format_validation_error(err, source)) from None
+
+
+def parse_int_list(text: str, field: str, ok: Callable[[int], bool], allowed: str
+                   ) -> tuple[int, ...]:
+    """Comma-separated distinct integers (spaces ignored, any order), each passing ``ok``;
+    else ``ConfigError`` naming ``field``, the value and ``allowed``."""
+    try:
+        vals = tuple(int(v) for v in text.replace(" ", "").split(","))
+    except ValueError:
+        vals = ()
+    if not vals or not all(ok(v) for v in vals) or len(set(vals)) < len(vals):
+        raise ConfigError(f"{field} = {text!r}: allowed: {allowed}")
+    return vals
 
 
 def load_toml(path: str | Path, field: str = "--config") -> dict[str, Any]:
