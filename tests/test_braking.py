@@ -218,6 +218,80 @@ def test_a_slab_as_wide_as_the_cell_is_delamination_not_wear() -> None:
     assert m["wear_depth_mean_pad_m"] == pytest.approx(area / (it.phi[PAD] * w), rel=1e-12)
 
 
+def _free_chunk(it, xc: float, n: int) -> np.ndarray:
+    """Cut the bonds round the ``n`` pad particles nearest to (xc, pad surface): a debris
+    component of the pad; returns its mask."""
+    p, b = it.sim.p, it.bonds
+    pad = np.flatnonzero(p.group == PAD)
+    w = it.width
+    dx = p.pos[pad, 0] - xc
+    dx -= w * np.rint(dx / w)
+    dy = p.pos[pad, 1] - (p.pos[pad, 1] - p.radius[pad]).min()
+    chunk = np.zeros(p.n, dtype=bool)
+    chunk[pad[np.argsort(dx**2 + dy**2)[:n]]] = True
+    b.mode[chunk[b.i] != chunk[b.j]] = TENSILE
+    return chunk
+
+
+def test_outlet_ejects_debris_after_its_residence_length() -> None:
+    """Two pad chunks are freed and carried in -x in steps of W/8 (as the disc carries
+    debris); with the residence length L = 0.6 W the chunk that moves leaves at the first
+    check where its travel reaches L (5 steps: 0.625 W), the chunk that stays (lodged in a
+    pit) never does. Ejected: group EJECTED, frozen, moved rigidly (pair distances kept to
+    1e-12 relative) below the disc's anchored layer, farther than a contact from every
+    live particle and from each other; counted as worn, depth = area / (phi W)."""
+    from tribodem.braking.model import EJECTED
+    from tribodem.braking.outlet import Outlet
+
+    it = build_interface(SMALL, 0.33e6)
+    p = it.sim.p
+    w = it.width
+    ref = reference(it)
+    moving = _free_chunk(it, 0.25 * w, 4)
+    lodged = _free_chunk(it, 0.75 * w, 3)
+    out = Outlet(it, 0.6 * w)
+    assert out.check(it) == 0
+    idx = np.flatnonzero(moving)
+    d0 = np.linalg.norm(p.pos[idx[:, None], :2] - p.pos[idx[None, :], :2], axis=2)
+    for k in range(1, 7):
+        before = p.group[idx].copy()
+        if (before != EJECTED).all():
+            p.pos[moving, 0] = np.mod(p.pos[moving, 0] - w / 8, w)
+        n = out.check(it)
+        if k < 5:
+            assert n == 0 and (p.group[moving] == PAD).all(), k
+        elif k == 5:
+            assert n == moving.sum() and (p.group[moving] == EJECTED).all()
+    assert (p.group[lodged] == PAD).all()
+    gone = p.group == EJECTED
+    assert (p.vel[gone] == 0).all() and (p.omega[gone] == 0).all()
+    assert (p.fixed[gone] & (FIX_X | FIX_Y)).all()
+    x = p.pos[idx, 0]
+    d = p.pos[idx[:, None], :2] - p.pos[idx[None, :], :2]
+    d[..., 0] -= w * np.rint(d[..., 0] / w)
+    np.testing.assert_allclose(np.linalg.norm(d, axis=2), d0, rtol=1e-12, atol=1e-18)
+    assert (x >= 0).all() and (x < w).all()
+    live = ~gone
+    rmax = float(p.radius.max())
+    assert p.pos[gone, 1].max() + rmax < p.pos[live, 1].min() - rmax
+    m = measure(it, ref, 0.0)
+    area = float((np.pi * p.radius[moving] ** 2).sum())
+    assert m["ejected_particles_pad"] == moving.sum() and m["ejected_particles_disc"] == 0
+    assert m["ejected_depth_pad_m"] == pytest.approx(area / (it.phi[PAD] * w), rel=1e-12)
+    assert m["worn_particles_pad"] == moving.sum()  # the lodged chunk has not moved
+    assert m["debris_particles"] == lodged.sum()
+    # a second ejection goes beside the first in the store, never onto it
+    p.pos[lodged, 0] = np.mod(p.pos[lodged, 0] + 0.3 * w, w)
+    out.length = 0.25 * w
+    assert out.check(it) == lodged.sum()
+    g = np.flatnonzero(p.group == EJECTED)
+    dd = p.pos[g[:, None], :2] - p.pos[g[None, :], :2]
+    dd[..., 0] -= w * np.rint(dd[..., 0] / w)
+    gap = np.linalg.norm(dd, axis=2) - (p.radius[g][:, None] + p.radius[g][None, :])
+    other = moving[g][:, None] != moving[g][None, :]
+    assert gap[other].min() > 0.0
+
+
 def test_absorbing_backing_lets_waves_leave_the_pad() -> None:
     """The Lysmer backing (rest of the pad) absorbs the waves a free back face reflects:
     measured 1.1e-9 J vs 1.1e-8 J after 1000 steps (~15 pad transits)."""
@@ -349,6 +423,10 @@ def test_cli_refuses_bad_input(tmp_path: Path) -> None:
     r = _cli("run", "--condition", "5", "--config", str(bad), "--out", str(tmp_path / "v"))
     assert r.returncode == 2 and "distance_m" in r.stderr and "duration_s" in r.stderr
     assert "Traceback" not in r.stderr and not (tmp_path / "v").exists()
+    bad.write_text("[run]\noutlet_length_m = -2e-4\n")
+    r = _cli("run", "--condition", "5", "--config", str(bad), "--out", str(tmp_path / "u"))
+    assert r.returncode == 2 and "outlet_length_m" in r.stderr and "-0.0002" in r.stderr
+    assert "Traceback" not in r.stderr and not (tmp_path / "u").exists()
 
 
 def _tiny(change: dict | None = None) -> RunSetup:
@@ -357,15 +435,20 @@ def _tiny(change: dict | None = None) -> RunSetup:
     return RunSetup(**{**kw, **(change or {})})
 
 
+@pytest.mark.parametrize("change", [{}, {"outlet_length_m": 10e-6, "duration_s": 2e-6}],
+                         ids=["closed", "outlet"])
 def test_resume_in_process_equals_the_uninterrupted_run(tmp_path: Path,
-                                                        monkeypatch: pytest.MonkeyPatch
-                                                        ) -> None:
+                                                        monkeypatch: pytest.MonkeyPatch,
+                                                        change: dict) -> None:
     """Interrupted at the 8th sample (after the checkpoint of sample 6), then resumed:
-    rows, pvd indexes, snapshots and summary are bitwise the uninterrupted run's."""
+    rows, pvd indexes, snapshots and summary are bitwise the uninterrupted run's; with
+    the debris outlet too (its travel and store state are in the checkpoint)."""
     import tribodem.braking.run as run_mod
     from tribodem.braking.run import read_checkpoint
 
-    full = run_braking(_tiny(), tmp_path / "a")
+    full = run_braking(_tiny(change), tmp_path / "a")
+    if change:
+        assert full["ejected_particles_disc"] + full["ejected_particles_pad"] > 0
     real = run_mod.measure
     calls = [0]
 
@@ -377,12 +460,12 @@ def test_resume_in_process_equals_the_uninterrupted_run(tmp_path: Path,
 
     monkeypatch.setattr(run_mod, "measure", interrupted)
     with pytest.raises(KeyboardInterrupt):
-        run_braking(_tiny(), tmp_path / "b")
+        run_braking(_tiny(change), tmp_path / "b")
     monkeypatch.setattr(run_mod, "measure", real)
     rec = read_checkpoint(tmp_path / "b" / "checkpoint.npz")
     assert 0 < rec["done"] < rec["total_steps"] and not rec["finished"]
     # checkpoint_every and figures may change on resume; the physics may not
-    res = run_braking(_tiny({"checkpoint_every": 5}), tmp_path / "b", resume=True)
+    res = run_braking(_tiny({**change, "checkpoint_every": 5}), tmp_path / "b", resume=True)
     for k, v in full.items():
         if not k.startswith("wall_time"):
             assert repr(res[k]) == repr(v), k
@@ -392,7 +475,7 @@ def test_resume_in_process_equals_the_uninterrupted_run(tmp_path: Path,
     from tribodem.io.config import ConfigError
 
     with pytest.raises(ConfigError, match=r"samples = 13 differs .* 12"):
-        run_braking(_tiny({"samples": 13}), tmp_path / "b", resume=True)
+        run_braking(_tiny({**change, "samples": 13}), tmp_path / "b", resume=True)
 
 
 def test_instability_keeps_rows_and_a_stopped_summary(tmp_path: Path,
@@ -511,9 +594,11 @@ def test_braking_example_configs_resolve() -> None:
     from tribodem.braking.cli import _config, setup_from_config
 
     root = Path(__file__).resolve().parents[1] / "examples"
-    for name in ("braking_steady.toml", "braking_wide.toml"):
+    for name in ("braking_steady.toml", "braking_wide.toml", "braking_outlet.toml"):
         s = setup_from_config(_config(5, root / name, False))
         assert s.until_steady and s.max_distance_m > 0, name
+    assert setup_from_config(_config(5, root / "braking_outlet.toml", False)
+                             ).outlet_length_m == pytest.approx(216e-6)
     # a fixed sliding distance: each condition slides 12 mm at its own speed (table 4)
     for cond, speed in ((5, 47.12), (3, 31.41)):
         s = setup_from_config(_config(cond, root / "braking_saturated.toml", False))

@@ -121,6 +121,11 @@ class RunCfg(_Strict):
                                 description="the disc starts at rest under the loaded pad "
                                             "and reaches the speed linearly over this "
                                             "time (s); 0 = at speed from the start")
+    outlet_length_m: float = Field(
+        0.0, ge=0, le=0.1,
+        description="debris outlet: a debris component leaves the cell once carried this "
+                    "far (m) along the sliding relative to the pad (residence length, e.g. "
+                    "a pad plateau, 50-500 um); 0 = closed cell, as in seed 000")
     checkpoint_every: int = Field(
         0, ge=0, le=100_000,
         description="samples between checkpoints (checkpoint.npz in the output folder); "
@@ -205,7 +210,7 @@ def setup_from_config(cfg: BrakingConfig) -> Any:
                     figures=r.figures, checkpoint_every=r.checkpoint_every,
                     until_steady=r.until_steady, max_distance_m=r.max_distance_m,
                     steady_tolerance=r.steady_tolerance, ramp_s=r.ramp_s,
-                    speed_ramp_s=r.speed_ramp_s)
+                    speed_ramp_s=r.speed_ramp_s, outlet_length_m=r.outlet_length_m)
 
 
 #: config fields a resumed run may change (they do not change the results)

@@ -18,9 +18,12 @@ Definitions (reference state = the loaded interface at the start of sliding):
   on its own (``delaminated_particles_*``, ``delaminated_depth_*_m``) and counted neither
   as debris nor as wear; once it breaks into pieces narrower than the cell they are
   debris again. Cells whose bodies never crack through are unaffected.
+- **ejected**: particles that left the interface through the debris outlet
+  (``outlet``, ``[run] outlet_length_m``; none in the closed cell of the seed): worn
+  material, never debris again; ``ejected_depth_*_m`` is their solid area over ``phi W``.
 - **worn** particles: debris particles displaced by more than one mean radius from
   their place in their body's frame (the disc's rigid sliding removed): material that
-  left the surface, not a cracked grain still in its seat.
+  left the surface, not a cracked grain still in its seat; and every ejected particle.
 - **wear depth, mean** (per body): the solid area of the body's worn particles over
   the cell width and the packing fraction, ``h = sum(pi r^2) / (phi W)`` (m): the
   thickness of intact material removed, the area form of "vertical displacement of the
@@ -48,7 +51,7 @@ import numpy as np
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
-from tribodem.braking.model import DISC, PAD, Interface
+from tribodem.braking.model import DISC, EJECTED, PAD, Interface
 
 
 @dataclass
@@ -142,13 +145,14 @@ def layers(iface: Interface, matrix: np.ndarray, lab: np.ndarray) -> np.ndarray:
 
 
 def force_chains(iface: Interface) -> dict[str, np.ndarray]:
-    """Pairs carrying force (contacts + intact bonds, summed per pair): i, j, normal force
-    (N, + compression)."""
+    """Pairs carrying force (contacts + intact bonds, summed per pair; ejected particles
+    left out): i, j, normal force (N, + compression)."""
     sim = iface.sim
     n = sim.p.n
     c = sim.contacts()
     b = iface.bonds
-    ok = b.intact
+    gone = sim.p.group == EJECTED
+    ok = b.intact & ~gone[b.i]  # an ejected component keeps its bonds, out of the cell
     i = np.concatenate([c["i"], b.i[ok]]).astype(np.int64)
     j = np.concatenate([c["j"], b.j[ok]]).astype(np.int64)
     f = np.concatenate([c["normal_force"], b.fn[ok]])
@@ -164,12 +168,13 @@ def measure(iface: Interface, ref: Reference, slid: float) -> dict[str, float]:
     sliding distance since the reference (m). SI units."""
     p = iface.sim.p
     matrix, lab = classify(iface)
-    layer = layers(iface, matrix, lab)
-    debris = ~matrix & ~layer
+    gone = p.group == EJECTED
+    layer = layers(iface, matrix | gone, lab) & ~gone
+    debris = ~matrix & ~layer & ~gone
     u = p.pos - ref.pos
     u[ref.group == DISC, 0] += slid
     u[:, 0] -= ref.width * np.rint(u[:, 0] / ref.width)
-    worn = debris & (np.linalg.norm(u, axis=1) > float(ref.radius.mean()))
+    worn = (debris & (np.linalg.norm(u, axis=1) > float(ref.radius.mean()))) | gone
     out: dict[str, float] = {}
     area = np.pi * ref.radius**2
     w = ref.width
@@ -177,6 +182,9 @@ def measure(iface: Interface, ref: Reference, slid: float) -> dict[str, float]:
         d = worn & (ref.group == body)
         out[f"worn_particles_{name}"] = float(d.sum())
         out[f"debris_particles_{name}"] = float((debris & (ref.group == body)).sum())
+        ej = gone & (ref.group == body)
+        out[f"ejected_particles_{name}"] = float(ej.sum())
+        out[f"ejected_depth_{name}_m"] = float(area[ej].sum() / (ref.phi[body] * w))
         lay = layer & (ref.group == body)
         out[f"delaminated_particles_{name}"] = float(lay.sum())
         out[f"delaminated_depth_{name}_m"] = float(area[lay].sum() / (ref.phi[body] * w))

@@ -50,6 +50,8 @@ from tribodem.materials.library import CU_PM, Q345B, MaterialSpec
 from tribodem.materials.specimen import compact_by_radius_scaling
 
 DISC, PAD = 1, 2  # particle groups
+#: group of the particles that left the interface through the debris outlet (``outlet``)
+EJECTED = 3
 PHI0 = 0.35  # area fraction of the random placement
 PHI_TARGET = 0.82  # area fraction of the particle count before the stress adjustment
 MASS_SCALE = 1.0e4  # density multiplier during compaction only (geometry only is kept)

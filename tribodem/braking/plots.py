@@ -7,7 +7,7 @@ from typing import Any
 
 import numpy as np
 
-from tribodem.braking.model import Interface
+from tribodem.braking.model import EJECTED, Interface
 from tribodem.io.results import write_figure
 
 
@@ -46,11 +46,12 @@ def plot_run(out: Path, rows: list[dict[str, float]], frames: dict[str, dict[str
     fig, axes = plt.subplots(1, len(keys), figsize=(6.5 * len(keys), 5.0), squeeze=False)
     for ax, k in zip(axes[0], keys, strict=True):
         fr = frames[k]
-        pos = fr["pos"].copy()
+        live = fr["group"] != EJECTED  # the outlet's store is not part of the cell
+        pos = fr["pos"][live].copy()
         pos[:, 0] = np.mod(pos[:, 0], w)
-        mag = np.linalg.norm(fr["disp"], axis=1) * 1e6
-        _disks(ax, pos, fr["radius"], mag, "viridis", "displacement (um)", fig)
-        d = fr["detached"]
+        mag = np.linalg.norm(fr["disp"][live], axis=1) * 1e6
+        _disks(ax, pos, fr["radius"][live], mag, "viridis", "displacement (um)", fig)
+        d = fr["detached"][live]
         ax.scatter(pos[d, 0] * 1e6, pos[d, 1] * 1e6, s=4, c="r", marker="x",
                    label="detached (debris)")
         ax.set_title(f"{k}: sliding {float(fr['slid']) * 1e6:.1f} um")
@@ -59,9 +60,10 @@ def plot_run(out: Path, rows: list[dict[str, float]], frames: dict[str, dict[str
     write_figure(out / "displacement.png", fig)
     # velocity vectors (fig 13), disc frame-free: lab velocities
     fr = frames["end"]
-    pos = fr["pos"].copy()
+    live = fr["group"] != EJECTED
+    pos = fr["pos"][live].copy()
     pos[:, 0] = np.mod(pos[:, 0], w)
-    v = fr["vel"]
+    v = fr["vel"][live]
     fig, ax = plt.subplots(figsize=(8, 5.5))
     sp = np.linalg.norm(v[:, :2], axis=1)
     q = ax.quiver(pos[:, 0] * 1e6, pos[:, 1] * 1e6, v[:, 0], v[:, 1], sp, cmap="plasma",

@@ -52,6 +52,7 @@ from tribodem.braking.conditions import SEED_BRAKING_TIME_S, pressure_to_load, s
 from tribodem.braking.measure import Reference, force_chains, measure, reference
 from tribodem.braking.model import (
     DISC,
+    EJECTED,
     PAD,
     Geometry,
     Interface,
@@ -60,6 +61,7 @@ from tribodem.braking.model import (
     start_sliding,
     wall_index,
 )
+from tribodem.braking.outlet import Outlet
 from tribodem.dem import compiled as dem_compiled
 from tribodem.dem.engine import cross_group_sum
 from tribodem.dem.thermal import Thermal, read_curve
@@ -113,6 +115,9 @@ class RunSetup:
     #: sliding ramped up: the disc starts at rest under the pad (full load) and its speed
     #: rises linearly to ``speed_m_s`` over ``speed_ramp_s`` seconds (0: at speed at once)
     speed_ramp_s: float = 0.0
+    #: debris outlet (``outlet``): a debris component leaves the cell once carried this
+    #: far (m) along the sliding relative to the pad; 0 = closed cell (seed 000)
+    outlet_length_m: float = 0.0
 
 
 class LoopStep(NamedTuple):
@@ -355,7 +360,8 @@ def read_checkpoint(path: str | Path) -> dict[str, Any]:
 
 #: setup fields added after checkpoints were first written, with the value the run of an
 #: older checkpoint (which does not record them) had
-ADDED_FIELDS = {("geometry", "first_mode"): 1}
+ADDED_FIELDS: dict[tuple[str, ...], Any] = {("geometry", "first_mode"): 1,
+                                             ("outlet_length_m",): 0.0}
 
 
 def check_resumable(rec: dict[str, Any], setup: RunSetup, path: str | Path) -> None:
@@ -363,8 +369,11 @@ def check_resumable(rec: dict[str, Any], setup: RunSetup, path: str | Path) -> N
     (only ``checkpoint_every`` and ``figures`` may change); an older checkpoint's missing
     fields count as their ``ADDED_FIELDS`` values."""
     recorded = json.loads(json.dumps(rec["setup"]))
-    for (group, key), value in ADDED_FIELDS.items():
-        recorded.get(group, {}).setdefault(key, value)
+    for path, value in ADDED_FIELDS.items():
+        d = recorded
+        for key in path[:-1]:
+            d = d.get(key, {})
+        d.setdefault(path[-1], value)
     diff = differences(recorded, setup_record(setup))
     if diff:
         name, old, new = diff[0]
@@ -484,6 +493,9 @@ def run_braking(setup: RunSetup, out: Path | None = None, *, resume: bool = Fals
         _thermal(iface, setup, t0)
     start_sliding(iface, setup.speed_m_s)
     ref = reference(iface)
+    outlet = Outlet(iface, setup.outlet_length_m) if setup.outlet_length_m > 0 else None
+    # outlet checks at most every quarter cell of disc travel (exact minimum images)
+    outlet_every = max(1, int(0.25 * iface.width / (setup.speed_m_s * sim.dt)))
     speed_steps = int(math.ceil(setup.speed_ramp_s / sim.dt)) if setup.speed_ramp_s > 0 else 0
     if speed_steps:  # the disc starts at rest under the pad
         sim.p.vel[sim.p.group == DISC, 0] = 0.0
@@ -525,6 +537,8 @@ def run_braking(setup: RunSetup, out: Path | None = None, *, resume: bool = Fals
                "kinetic_energy_J": sim.kinetic_energy(),
                "interface_force_N": interface_load(iface)}
         row.update(measure(iface, ref, slid))
+        if rows and list(rows[0]) != list(row):  # a checkpoint of an older version
+            rows[:] = [{k: r.get(k, 0.0) for k in row} for r in rows]
         rows.append({k: float(v) for k, v in row.items()})
         if out is not None and any(done >= s and s not in seen for s in vtk_at):
             for s in vtk_at:
@@ -561,6 +575,8 @@ def run_braking(setup: RunSetup, out: Path | None = None, *, resume: bool = Fals
         }
         arrays = {"rows": np.array([[r[c] for c in cols] for r in rows], dtype=np.float64),
                   "ref_pos": ref.pos, "ref_radius": ref.radius}
+        if outlet is not None:
+            arrays.update(outlet.state())
         for name, fr in frames.items():
             for key, v in fr.items():
                 arrays[f"frame_{name}_{key}"] = np.asarray(v)
@@ -591,6 +607,8 @@ def run_braking(setup: RunSetup, out: Path | None = None, *, resume: bool = Fals
                    for row in a["rows"]]
         for name, keys in r["frames"].items():
             frames[name] = {k: a[f"frame_{name}_{k}"] for k in keys}
+        if outlet is not None:
+            outlet.set_state(a)
         t0, wall_y0 = float(r["t0"]), float(r["wall_y0"])
         wall_before = {"build": float(r["wall_time_build_s"]),
                        "sliding": float(r["wall_time_sliding_s"]),
@@ -622,7 +640,13 @@ def run_braking(setup: RunSetup, out: Path | None = None, *, resume: bool = Fals
                     bar.total = total_steps
                     getattr(bar, "refresh", lambda: None)()
                 k = min(every, total_steps - done)
-                sim.step(k)
+                if outlet is None:
+                    sim.step(k)
+                else:
+                    for m in [outlet_every] * (k // outlet_every) + [k % outlet_every]:
+                        if m:
+                            sim.step(m)
+                            outlet.check(iface)
                 done += k
                 sample()
                 if "early" not in frames and done >= 0.1 * total_steps:
@@ -660,7 +684,8 @@ def run_braking(setup: RunSetup, out: Path | None = None, *, resume: bool = Fals
     rmax = float(p.radius.max())
     y_lo = float(p.pos[iface.anchor_disc, 1].min()) - rmax
     y_hi = float(iface.wall.point[1]) + rmax
-    inside = np.isfinite(p.pos).all(axis=1) & (p.pos[:, 1] >= y_lo) & (p.pos[:, 1] <= y_hi)
+    inside = (np.isfinite(p.pos).all(axis=1) & (p.pos[:, 1] >= y_lo)
+              & (p.pos[:, 1] <= y_hi) & (p.group != EJECTED))
     t_sim = sim.time - t0
     tt = np.array([r["time_s"] for r in rows])
     hh = np.array([r["wear_depth_mean_m"] for r in rows])
@@ -692,7 +717,10 @@ def run_braking(setup: RunSetup, out: Path | None = None, *, resume: bool = Fals
             "compressive_force_chains", "transfer_layer_thickness_m", "wear_range_disc_m",
             "wear_range_pad_m", "wear_range_ratio", "debris_max_vertical_displacement_m",
             "delaminated_particles_pad", "delaminated_depth_pad_m",
-            "delaminated_particles_disc", "delaminated_depth_disc_m")},
+            "delaminated_particles_disc", "delaminated_depth_disc_m",
+            "ejected_particles_pad", "ejected_depth_pad_m", "ejected_particles_disc",
+            "ejected_depth_disc_m")},
+        "outlet_length_m": setup.outlet_length_m,
         "steady_wear_rate_m_s": rate,
         "wear_rate_steady_m_per_m": st["rate"],
         "wear_rate_middle_third_m_per_m": st["rate_mid"],
@@ -806,10 +834,12 @@ def _outcome_notes(summary: dict[str, Any]) -> list[str]:
             "steady-state rule not passed within the distance slid: "
             "wear_rate_steady_m_per_m is the slope over the last two thirds of a rate still "
             "changing (compare wear_rate_middle_third_m_per_m and "
-            "wear_rate_last_third_m_per_m); in the closed periodic cell the rate falls "
-            "towards zero over ~10-16 mm as the debris layer takes up the sliding (no debris "
-            "leaves the cell): the depth of a short run is a run-in depth (docs/braking.md "
-            "'Long slides')")
+            "wear_rate_last_third_m_per_m)" + (
+                "" if summary["outlet_length_m"] > 0 else
+                "; in the closed periodic cell the rate falls towards zero over ~10-16 mm as "
+                "the debris layer takes up the sliding (no debris leaves the cell): the "
+                "depth of a short run is a run-in depth (docs/braking.md 'Long slides'); "
+                "[run] outlet_length_m lets debris leave"))
     return notes
 
 
@@ -848,6 +878,14 @@ def _assumptions(setup: RunSetup) -> list[str]:
     else:
         a.append("micro-parameters: the seed's table 3 values, uncalibrated in tribodem "
                  "(E ~ 88/79 GPa instead of 201/178 GPa)")
+    if setup.outlet_length_m > 0:
+        a.append(f"debris outlet: a debris component leaves the cell (ejected, counted as "
+                 f"worn) once carried {1e6 * setup.outlet_length_m:g} um along the sliding "
+                 "relative to the pad (the residence length: the contact plateau it crosses; "
+                 "not given by the seed, whose cell is closed); docs/braking.md 'Debris "
+                 "outlet'")
+    else:
+        a.append("closed cell (the seed's): no debris leaves; the third body accumulates")
     if setup.thermal_curve is None:
         a.append("no temperature boundary (the seed's figure 9 curve is not given in the "
                  "text; over microseconds any 8 s curve changes by ~1e-6 of its range)")

@@ -1,0 +1,130 @@
+"""Issue 15: the steady wear rate with the debris outlet, its scatter, seed 000's trends.
+
+    python docs/data/braking_outlet/analyse.py PATTERN [--conditions 5,1,3] [--from 4e-3]
+
+``PATTERN`` holds ``{c}`` (condition) and ``{k}`` (packing), e.g. ``runs/c{c}_L216_p{k}``;
+``A|B`` takes the first alternative holding a finished run. The runs are the default cell
+with the 324-um pad and ``[run] outlet_length_m`` (``c5.toml``), 12 mm of sliding. Per
+run: the steady wear rate of its summary (slope of the pad's mean wear depth over the last
+two thirds of the distance), the rate from ``--from`` (default 4 mm) to the end, the
+steady-state rule (``tribodem.braking.run.steady_state`` with ``STEADY_CUTS``) tested as
+``[run] until_steady`` tests it -- first at the default 40 us of condition 5 (1.9 mm),
+then every 20 % of that -- the distance where it first passes, and the contact fraction.
+Per condition: mean and sd/mean of the rates over the packings. Then the paired changes of
+the rate 13 -> 21 kN (condition 1 -> 5) and 800 -> 1200 r/min (3 -> 5) with their 95 %
+intervals (``tribodem.braking.compare``) beside the seed's. Markdown on stdout.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from tribodem.braking.cli import RunCfg
+from tribodem.braking.compare import SEED_CHANGES, _series, change_with_error, ci95, seed_inside
+from tribodem.braking.conditions import get_condition
+from tribodem.braking.run import STEADY_BLOCK, STEADY_CUTS, _slope, steady_state
+
+V5 = get_condition(5).speed_m_s
+FIRST = RunCfg().duration_s * V5  # m: where until_steady first tests (40 us at 1200 r/min)
+SEED = {f"{name} ({a} -> {b})": (a, pct) for name, a, b, pct, _ in SEED_CHANGES
+        if (a, b) in ((1, 5), (3, 5))}
+
+
+def run_dir(pattern: str, c: int, k: int) -> Path | None:
+    """The first alternative of ``pattern`` (``A|B``) with a finished run."""
+    for alt in pattern.split("|"):
+        d = Path(alt.format(c=c, k=k))
+        if (d / "summary.json").exists():
+            return d
+    return None
+
+
+def first_pass(s: np.ndarray, h: np.ndarray, tol: float) -> tuple[float, float]:
+    """(distance m, rate m/m) at which ``until_steady`` would stop this run: tests at
+    FIRST, then every STEADY_BLOCK x FIRST; (nan, nan) if it never passes."""
+    at = FIRST
+    while at <= s[-1] * (1 + 1e-9):
+        m = s <= at * (1 + 1e-9)
+        st = steady_state(s[m], h[m], tol, STEADY_CUTS)
+        if st["steady"]:
+            return at, st["rate"]
+        at += STEADY_BLOCK * FIRST
+    return float("nan"), float("nan")
+
+
+def reading(d: Path, start: float) -> dict[str, float]:
+    """One run's rates (m/m), rule outcome and contact fraction."""
+    ts = _series(d)
+    sm = json.loads((d / "summary.json").read_text())
+    s, h = ts["sliding_distance_m"], ts["wear_depth_mean_pad_m"]
+    m = s >= start
+    at, rate_at = first_pass(s, h, RunCfg().steady_tolerance)
+    ej = ts["ejected_depth_pad_m"]
+    return {"steady": sm["wear_rate_steady_m_per_m"], "from": _slope(s[m], h[m]),
+            "ejected": _slope(s[m], ej[m]), "rule": bool(sm["steady_reached"]),
+            "pass_at": at, "pass_rate": rate_at, "contact": sm["contact_fraction"],
+            "slid": float(s[-1]), "layer": float(ts["transfer_layer_thickness_m"][m].mean()),
+            "cpu": sm["wall_time_s"]}
+
+
+def main(pattern: str, conds: list[int], start: float) -> None:
+    ks = [k for k in range(200) if all(run_dir(pattern, c, k) for c in conds)]
+    r = {c: [reading(run_dir(pattern, c, k), start) for k in ks] for c in conds}
+    print(f"pattern {pattern}; packings {ks}; rates from {start * 1e3:g} mm\n")
+    print("| condition | packing | slid mm | steady rate (last 2/3) um/mm | rate from "
+          f"{start * 1e3:g} mm um/mm | ejected um/mm | rule on the whole run | until_steady "
+          "would stop at mm (rate um/mm) | contact fraction | transfer layer um | wall s |\n"
+          "|---|---|---|---|---|---|---|---|---|---|---|")
+    for c in conds:
+        for k, x in zip(ks, r[c], strict=True):
+            stop = ("no pass" if not np.isfinite(x["pass_at"]) else
+                    f"{x['pass_at'] * 1e3:.2f} ({x['pass_rate'] * 1e3:.1f})")
+            print(f"| {c} | {k} | {x['slid'] * 1e3:.2f} | {x['steady'] * 1e3:.2f} | "
+                  f"{x['from'] * 1e3:.2f} | {x['ejected'] * 1e3:.2f} | "
+                  f"{'steady' if x['rule'] else 'not steady'} | {stop} | "
+                  f"{x['contact']:.2f} | {x['layer'] * 1e6:.1f} | {x['cpu']:.0f} |")
+    print("\n| condition | steady rate um/mm: mean, sd/mean | rate from "
+          f"{start * 1e3:g} mm: mean, sd/mean | contact fraction (min-max) |\n|---|---|---|---|")
+    for c in conds:
+        a = np.array([x["steady"] for x in r[c]])
+        b = np.array([x["from"] for x in r[c]])
+        cf = [x["contact"] for x in r[c]]
+        print(f"| {c} | {a.mean() * 1e3:.2f}, {a.std(ddof=1) / a.mean():.0%} | "
+              f"{b.mean() * 1e3:.2f}, {b.std(ddof=1) / b.mean():.0%} | "
+              f"{min(cf):.2f}-{max(cf):.2f} |")
+    if 5 not in conds or len(ks) < 2:
+        return
+    print("\n| trend (steady rate) | seed | ours, last 2/3 | ours, from "
+          f"{start * 1e3:g} mm | seed inside |\n|---|---|---|---|---|")
+    for name, (c0, seed_pct) in SEED.items():
+        if c0 not in conds:
+            continue
+        cells = []
+        for key in ("steady", "from"):
+            a = np.array([x[key] for x in r[c0]])
+            b = np.array([x[key] for x in r[5]])
+            pct, se = change_with_error(a, b, paired=True)
+            cells.append((pct, ci95(se, len(ks))))
+        inside = seed_inside(seed_pct, *cells[0])
+        pm = [f"{p:+.1f} +- {h:.1f} %" for p, h in cells]
+        print(f"| {name} | {seed_pct:+.2f} % | {pm[0]} | {pm[1]} | "
+              f"{'yes' if inside else 'no'} |")
+    print(f"\n(+- : half-width of the paired 95 % interval over {len(ks)} packings, Student t)")
+
+
+if __name__ == "__main__":
+    args = sys.argv[1:]
+    conds, start = [5, 1, 3], 4e-3
+    if "--conditions" in args:
+        i = args.index("--conditions")
+        conds = [int(c) for c in args[i + 1].split(",")]
+        del args[i:i + 2]
+    if "--from" in args:
+        i = args.index("--from")
+        start = float(args[i + 1])
+        del args[i:i + 2]
+    main(args[0], conds, start)
