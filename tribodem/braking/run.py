@@ -14,7 +14,10 @@ last-third rate within ``steady_tolerance`` of the middle-third rate, on the run
 the run cut to 90 % and 80 % of its distance: ``STEADY_CUTS``), at most
 ``max_distance_m``; every summary reports ``wear_rate_steady_m_per_m``, the run-in distance
 and depth, and ``contact_fraction`` (share of looks, one every ``CONTACT_EVERY`` steps, at
-which a disc-pad contact carries load). ``ramp_s`` ramps the load on from 0.
+which a disc-pad contact carries load). ``ramp_s`` ramps the load on from 0. The closed
+cell of the seed saturates (no debris leaves it); ``outlet_length_m`` lets debris leave
+(``braking.outlet``), checked between engine calls at most every quarter cell width of
+disc travel, so that the wear reaches a steady flow.
 
 Checkpoints and resuming (``run_braking(..., resume=True)``, ``tribodem braking run
 --resume``): one file, ``<out>/checkpoint.npz``, written atomically by the engine's

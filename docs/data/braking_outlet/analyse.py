@@ -6,7 +6,7 @@
 ``A|B`` takes the first alternative holding a finished run. The runs are the default cell
 with the 324-um pad and ``[run] outlet_length_m`` (``c5.toml``), 12 mm of sliding. Per
 run: the steady wear rate of its summary (slope of the pad's mean wear depth over the last
-two thirds of the distance), the rate from ``--from`` (default 4 mm) to the end, the
+two thirds of the distance), the rate from ``--from`` (default 2 mm) to the end, the
 steady-state rule (``tribodem.braking.run.steady_state`` with ``STEADY_CUTS``) tested as
 ``[run] until_steady`` tests it -- first at the default 40 us of condition 5 (1.9 mm),
 then every 20 % of that -- the distance where it first passes, and the contact fraction.
@@ -22,6 +22,7 @@ import sys
 from pathlib import Path
 
 import numpy as np
+from scipy.stats import chi2
 
 from tribodem.braking.cli import RunCfg
 from tribodem.braking.compare import SEED_CHANGES, _series, change_with_error, ci95, seed_inside
@@ -64,11 +65,27 @@ def reading(d: Path, start: float) -> dict[str, float]:
     m = s >= start
     at, rate_at = first_pass(s, h, RunCfg().steady_tolerance)
     ej = ts["ejected_depth_pad_m"]
-    return {"steady": sm["wear_rate_steady_m_per_m"], "from": _slope(s[m], h[m]),
+    win = {}
+    for width in (2e-3, 4e-3):  # rates of consecutive windows after the run-in third
+        edges = np.arange(s[-1] / 3.0, s[-1] + 1e-9, width)
+        win[width] = [_slope(s[(s >= a) & (s <= a + width)], h[(s >= a) & (s <= a + width)])
+                      for a in edges[:-1]]
+    grid = [_slope(s[(s >= a) & (s <= a + 2e-3)], h[(s >= a) & (s <= a + 2e-3)])
+            for a in np.arange(0.0, 12e-3 - 1e-9, 2e-3)]
+    return {"windows": win, "grid": grid, "steady": sm["wear_rate_steady_m_per_m"],
+            "from": _slope(s[m], h[m]),
             "ejected": _slope(s[m], ej[m]), "rule": bool(sm["steady_reached"]),
             "pass_at": at, "pass_rate": rate_at, "contact": sm["contact_fraction"],
             "slid": float(s[-1]), "layer": float(ts["transfer_layer_thickness_m"][m].mean()),
             "cpu": sm["wall_time_s"]}
+
+
+def sd_interval(x: np.ndarray) -> tuple[float, float, float]:
+    """sd/mean of ``x`` and its 95 % interval (chi-square on n - 1 degrees of freedom)."""
+    n = x.size
+    cv = float(x.std(ddof=1) / x.mean())
+    return (cv, cv * float(np.sqrt((n - 1) / chi2.ppf(0.975, n - 1))),
+            cv * float(np.sqrt((n - 1) / chi2.ppf(0.025, n - 1))))
 
 
 def main(pattern: str, conds: list[int], start: float) -> None:
@@ -87,15 +104,27 @@ def main(pattern: str, conds: list[int], start: float) -> None:
                   f"{x['from'] * 1e3:.2f} | {x['ejected'] * 1e3:.2f} | "
                   f"{'steady' if x['rule'] else 'not steady'} | {stop} | "
                   f"{x['contact']:.2f} | {x['layer'] * 1e6:.1f} | {x['cpu']:.0f} |")
-    print("\n| condition | steady rate um/mm: mean, sd/mean | rate from "
-          f"{start * 1e3:g} mm: mean, sd/mean | contact fraction (min-max) |\n|---|---|---|---|")
+    print("\n| condition | steady rate um/mm: mean, sd/mean between packings (95 % interval) "
+          f"| rate from {start * 1e3:g} mm: mean, sd/mean | within a run: sd/mean of "
+          "the rates of 2-mm / 4-mm windows after the run-in | contact fraction (min-max) "
+          "|\n|---|---|---|---|---|")
     for c in conds:
         a = np.array([x["steady"] for x in r[c]])
         b = np.array([x["from"] for x in r[c]])
         cf = [x["contact"] for x in r[c]]
-        print(f"| {c} | {a.mean() * 1e3:.2f}, {a.std(ddof=1) / a.mean():.0%} | "
+        cv, lo, hi = sd_interval(a)
+        within = []
+        for width in (2e-3, 4e-3):  # each run's windows relative to its own mean, pooled
+            rel = [np.array(x["windows"][width]) / np.mean(x["windows"][width]) for x in r[c]]
+            within.append(float(np.concatenate(rel).std(ddof=1)))
+        print(f"| {c} | {a.mean() * 1e3:.2f}, {cv:.0%} ({lo:.0%}-{hi:.0%}) | "
               f"{b.mean() * 1e3:.2f}, {b.std(ddof=1) / b.mean():.0%} | "
-              f"{min(cf):.2f}-{max(cf):.2f} |")
+              f"{within[0]:.0%} / {within[1]:.0%} | {min(cf):.2f}-{max(cf):.2f} |")
+    print("\n| condition | mean over the packings of the rate per 2-mm window from 0, um/mm "
+          "(is there a trend?) |\n|---|---|")
+    for c in conds:
+        per = np.array([x["grid"] for x in r[c]])
+        print(f"| {c} | {', '.join(f'{v * 1e3:.1f}' for v in per.mean(axis=0))} |")
     if 5 not in conds or len(ks) < 2:
         return
     print("\n| trend (steady rate) | seed | ours, last 2/3 | ours, from "
@@ -118,7 +147,7 @@ def main(pattern: str, conds: list[int], start: float) -> None:
 
 if __name__ == "__main__":
     args = sys.argv[1:]
-    conds, start = [5, 1, 3], 4e-3
+    conds, start = [5, 1, 3], 2e-3
     if "--conditions" in args:
         i = args.index("--conditions")
         conds = [int(c) for c in args[i + 1].split(",")]
