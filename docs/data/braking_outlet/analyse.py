@@ -25,7 +25,14 @@ import numpy as np
 from scipy.stats import chi2
 
 from tribodem.braking.cli import RunCfg
-from tribodem.braking.compare import SEED_CHANGES, _series, change_with_error, ci95, seed_inside
+from tribodem.braking.compare import (
+    SEED_CHANGES,
+    _series,
+    change_with_error,
+    ci95,
+    packings_for,
+    seed_inside,
+)
 from tribodem.braking.conditions import get_condition
 from tribodem.braking.run import STEADY_BLOCK, STEADY_CUTS, _slope, steady_state
 
@@ -128,20 +135,23 @@ def main(pattern: str, conds: list[int], start: float) -> None:
     if 5 not in conds or len(ks) < 2:
         return
     print("\n| trend (steady rate) | seed | ours, last 2/3 | ours, from "
-          f"{start * 1e3:g} mm | seed inside |\n|---|---|---|---|---|")
+          f"{start * 1e3:g} mm | seed inside | ours per unit time (rate x speed, last 2/3) | "
+          "seed inside | packings for +-10 pp (per metre / per time) |\n"
+          "|---|---|---|---|---|---|---|---|")
     for name, (c0, seed_pct) in SEED.items():
         if c0 not in conds:
             continue
         cells = []
-        for key in ("steady", "from"):
-            a = np.array([x[key] for x in r[c0]])
-            b = np.array([x[key] for x in r[5]])
+        v0, v5 = get_condition(c0).speed_m_s, V5
+        for key, f0, f5 in (("steady", 1.0, 1.0), ("from", 1.0, 1.0), ("steady", v0, v5)):
+            a = np.array([x[key] for x in r[c0]]) * f0
+            b = np.array([x[key] for x in r[5]]) * f5
             pct, se = change_with_error(a, b, paired=True)
-            cells.append((pct, ci95(se, len(ks))))
-        inside = seed_inside(seed_pct, *cells[0])
-        pm = [f"{p:+.1f} +- {h:.1f} %" for p, h in cells]
-        print(f"| {name} | {seed_pct:+.2f} % | {pm[0]} | {pm[1]} | "
-              f"{'yes' if inside else 'no'} |")
+            cells.append((pct, ci95(se, len(ks)), packings_for(se, len(ks))))
+        yes = ["yes" if seed_inside(seed_pct, *cells[i][:2]) else "no" for i in (0, 2)]
+        pm = [f"{p:+.1f} +- {h:.1f} %" for p, h, _ in cells]
+        print(f"| {name} | {seed_pct:+.2f} % | {pm[0]} | {pm[1]} | {yes[0]} | {pm[2]} | "
+              f"{yes[1]} | {cells[0][2]} / {cells[2][2]} |")
     print(f"\n(+- : half-width of the paired 95 % interval over {len(ks)} packings, Student t)")
 
 

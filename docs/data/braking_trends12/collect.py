@@ -1,9 +1,9 @@
 """Copy finished braking runs into this folder: summary.json and the time series reduced to
 the columns the analysis and a reader need.
 
-    python docs/data/braking_trends12/collect.py RUN_DIR [RUN_DIR ...]
+    python docs/data/braking_trends12/collect.py [--to DIR] RUN_DIR [RUN_DIR ...]
 
-Each RUN_DIR (e.g. ``runs/c1_p7``) lands here under its own name.
+Each RUN_DIR (e.g. ``runs/c1_p7``) lands here (or in DIR) under its own name.
 """
 
 from __future__ import annotations
@@ -16,14 +16,14 @@ from pathlib import Path
 HERE = Path(__file__).parent
 COLUMNS = ("time_s", "sliding_distance_m", "wear_depth_mean_pad_m", "broken_bonds",
            "debris_particles", "transfer_layer_thickness_m", "interface_force_N",
-           "delaminated_particles_pad")
+           "delaminated_particles_pad", "ejected_depth_pad_m")
 
 
-def collect(run: Path) -> None:
-    """Copy one finished run (summary.json, reduced timeseries.csv) into HERE/run.name."""
+def collect(run: Path, to: Path = HERE) -> None:
+    """Copy one finished run (summary.json, reduced timeseries.csv) into to/run.name."""
     if not (run / "summary.json").exists():
         raise SystemExit(f"{run}: no summary.json (not finished)")
-    out = HERE / run.name
+    out = to / run.name
     out.mkdir(exist_ok=True)
     shutil.copyfile(run / "summary.json", out / "summary.json")
     with open(run / "timeseries.csv", newline="") as f:
@@ -36,5 +36,9 @@ def collect(run: Path) -> None:
 
 
 if __name__ == "__main__":
-    for arg in sys.argv[1:]:
-        collect(Path(arg))
+    args = sys.argv[1:]
+    to = HERE
+    if args[:1] == ["--to"]:
+        to, args = Path(args[1]), args[2:]
+    for arg in args:
+        collect(Path(arg), to)
