@@ -144,6 +144,16 @@ def layers(iface: Interface, matrix: np.ndarray, lab: np.ndarray) -> np.ndarray:
     return spanning(p.pos[:, 0], p.radius, lab, w, cand)[lab] & ~matrix
 
 
+def partition(iface: Interface) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray,
+                                         np.ndarray]:
+    """Each particle's part now (module docstring): masks ``matrix``, ``layer``
+    (delaminated), ``debris``, ``gone`` (ejected) and the component label per particle."""
+    matrix, lab = classify(iface)
+    gone = iface.sim.p.group == EJECTED
+    layer = layers(iface, matrix | gone, lab) & ~gone
+    return matrix, layer, ~matrix & ~layer & ~gone, gone, lab
+
+
 def force_chains(iface: Interface) -> dict[str, np.ndarray]:
     """Pairs carrying force (contacts + intact bonds, summed per pair; ejected particles
     left out): i, j, normal force (N, + compression)."""
@@ -167,10 +177,7 @@ def measure(iface: Interface, ref: Reference, slid: float) -> dict[str, float]:
     """All scalar measurements now (see the module docstring); ``slid``: the disc's
     sliding distance since the reference (m). SI units."""
     p = iface.sim.p
-    matrix, lab = classify(iface)
-    gone = p.group == EJECTED
-    layer = layers(iface, matrix | gone, lab) & ~gone
-    debris = ~matrix & ~layer & ~gone
+    matrix, layer, debris, gone, lab = partition(iface)
     u = p.pos - ref.pos
     u[ref.group == DISC, 0] += slid
     u[:, 0] -= ref.width * np.rint(u[:, 0] / ref.width)

@@ -71,15 +71,12 @@ class Outlet:
     def check(self, iface: Interface) -> int:
         """Update the travel of the debris and eject the components that went
         ``length``; returns the number of particles ejected now."""
-        from tribodem.braking.measure import classify, layers
+        from tribodem.braking.measure import partition
 
         p = iface.sim.p
         w = iface.width
         x = p.pos[:, 0]
-        gone = p.group == EJECTED
-        matrix, lab = classify(iface)
-        debris = ~matrix & ~gone
-        debris &= ~layers(iface, matrix | gone, lab)
+        _, _, debris, _, lab = partition(iface)
         d = x - self.last_x
         d -= w * np.rint(d / w)
         keep = debris & self.tracking
@@ -123,7 +120,5 @@ class Outlet:
         p.vel[members] = 0.0
         p.omega[members] = 0.0
         p.fixed[members] |= np.uint8(FIX_TRANSLATION | FIX_ROTATION)
-        p.group[members] = EJECTED
-        self.tracking[members] = False
-        self.travel[members] = 0.0
+        p.group[members] = EJECTED  # the next check stops tracking them (not debris)
         self.shelf = np.array([cur + bw + self.gap, top, max(height, bh)])
