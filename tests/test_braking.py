@@ -292,6 +292,31 @@ def test_outlet_ejects_debris_after_its_residence_length() -> None:
     assert gap[other].min() > 0.0
 
 
+def test_remaining_thickness_falls_by_what_the_body_loses() -> None:
+    """Remaining thickness = intact matrix outside the anchored layer, solid area over
+    phi W: at the start it lies between the body's height less two anchored diameters
+    and its height; a pad chunk of area A freed and carried off lowers the pad's by
+    exactly A / (phi W) (rel 1e-12) and raises its wear depth by the same; the disc's
+    does not move."""
+    it = build_interface(SMALL, 0.33e6)
+    p = it.sim.p
+    w = it.width
+    ref = reference(it)
+    m0 = measure(it, ref, 0.0)
+    d = 4.0 * float(p.radius.mean())
+    for name, h in (("disc", SMALL.disc_height), ("pad", SMALL.pad_height)):
+        assert h - 2 * d - SMALL.amplitude < m0[f"remaining_thickness_{name}_m"] < h, name
+    chunk = _free_chunk(it, 0.5 * w, 6)
+    p.pos[chunk, 0] = np.mod(p.pos[chunk, 0] - 0.25 * w, w)
+    m1 = measure(it, ref, 0.0)
+    lost = float((np.pi * p.radius[chunk] ** 2).sum()) / (it.phi[PAD] * w)
+    assert m0["remaining_thickness_pad_m"] - m1["remaining_thickness_pad_m"] == \
+        pytest.approx(lost, rel=1e-12)
+    assert m1["wear_depth_mean_pad_m"] - m0["wear_depth_mean_pad_m"] == \
+        pytest.approx(lost, rel=1e-12)
+    assert m1["remaining_thickness_disc_m"] == m0["remaining_thickness_disc_m"]
+
+
 def test_absorbing_backing_lets_waves_leave_the_pad() -> None:
     """The Lysmer backing (rest of the pad) absorbs the waves a free back face reflects:
     measured 1.1e-9 J vs 1.1e-8 J after 1000 steps (~15 pad transits)."""
@@ -309,6 +334,24 @@ def test_a_wide_cell_is_compacted_as_densely_as_the_default_one() -> None:
     _, _, stats = compact_periodic(disc, w, 196e-6, seed=1)
     assert stats["relax_scale"] == 4.0
     assert stats["loose_fraction"] <= LOOSE_MAX, stats
+
+
+def test_a_tall_cell_is_compacted_until_jammed() -> None:
+    """A cell 3x taller than wide (100 x 300 um) closes slowly too: packing 4 at the
+    nominal relaxations leaves 17 % of its particles without a neighbour within the bond
+    gap; ``compact_periodic`` makes it again with longer relaxations until at most
+    LOOSE_MAX are. A packing jammed at once (packing 0) is the one-pass packing, bitwise."""
+    from tribodem.braking.model import _compact_once
+
+    disc, _ = materials("calibrated")
+    loose = _compact_once(disc, 100e-6, 300e-6, 4, 1e6, 40, disc.bond_gap, 1)[2]
+    assert loose["loose_fraction"] > 3 * LOOSE_MAX
+    _, _, stats = compact_periodic(disc, 100e-6, 300e-6, seed=4)
+    assert stats["loose_fraction"] <= LOOSE_MAX and stats["relax_scale"] >= 2, stats
+    pos, r, st0 = compact_periodic(disc, 100e-6, 300e-6, seed=0)
+    once = _compact_once(disc, 100e-6, 300e-6, 0, 1e6, 40, disc.bond_gap, 1)
+    assert st0["relax_scale"] == 1 and np.array_equal(pos, once[0])
+    assert np.array_equal(r, once[1])
 
 
 def test_plate_force_includes_backing_reaction() -> None:
@@ -356,7 +399,8 @@ def test_packings_for_a_target_interval() -> None:
 def quick_run(tmp_path_factory: pytest.TempPathFactory) -> tuple[dict, Path]:
     out = tmp_path_factory.mktemp("braking")
     setup = RunSetup(pressure_Pa=0.53e6, speed_m_s=47.12, duration_s=4e-6, geometry=SMALL,
-                     condition=5, samples=40, vtk_snapshots=2)
+                     condition=5, samples=40, vtk_snapshots=2,
+                     worn_through_diameters=0.0)  # as in _tiny
     return run_braking(setup, out), out
 
 
@@ -427,11 +471,18 @@ def test_cli_refuses_bad_input(tmp_path: Path) -> None:
     r = _cli("run", "--condition", "5", "--config", str(bad), "--out", str(tmp_path / "u"))
     assert r.returncode == 2 and "outlet_length_m" in r.stderr and "-0.0002" in r.stderr
     assert "Traceback" not in r.stderr and not (tmp_path / "u").exists()
+    bad.write_text("[run]\nworn_through_diameters = -1\n")
+    r = _cli("run", "--condition", "5", "--config", str(bad), "--out", str(tmp_path / "t"))
+    assert r.returncode == 2 and "worn_through_diameters" in r.stderr and "-1" in r.stderr
+    assert "Traceback" not in r.stderr and not (tmp_path / "t").exists()
 
 
 def _tiny(change: dict | None = None) -> RunSetup:
+    # SMALL's bodies are ~3 grains thick outside their anchored layers and one impact can
+    # take one: the worn-through guard is off in these mechanics tests (tested on its own)
     kw = dict(pressure_Pa=0.53e6, speed_m_s=47.12, duration_s=1e-6, geometry=SMALL,
-              condition=5, samples=12, vtk_snapshots=3, figures=False)
+              condition=5, samples=12, vtk_snapshots=3, figures=False,
+              worn_through_diameters=0.0)
     return RunSetup(**{**kw, **(change or {})})
 
 
@@ -500,6 +551,33 @@ def test_instability_keeps_rows_and_a_stopped_summary(tmp_path: Path,
     ts = np.genfromtxt(tmp_path / "timeseries.csv", delimiter=",", names=True)
     assert ts.size == s["steps"] // (s["steps_planned"] // 12) + 1 >= 3
     assert s["last_checkpoint"] is not None
+
+
+def test_a_worn_through_body_stops_the_run(tmp_path: Path) -> None:
+    """A floor above the bodies (``worn_through_diameters`` = 100: 1.4 mm against the
+    36-um disc) stops the run at its first sliding sample: ``RunStopped`` naming the
+    disc, every output written with status ``worn_through`` and the floor; a resume
+    reports the same stop with the same summary (wall times aside). Floor 0: never."""
+    from tribodem.io.runs import RunStopped
+
+    setup = _tiny({"worn_through_diameters": 100.0})
+    with pytest.raises(RunStopped, match="disc was worn through"):
+        run_braking(setup, tmp_path)
+    s = json.loads((tmp_path / "summary.json").read_text())
+    assert s["status"] == "worn_through" and s["worn_through"]["body"] == "disc"
+    ref_r = np.mean(np.genfromtxt(tmp_path / "timeseries.csv", delimiter=",",
+                                  names=True)["remaining_thickness_disc_m"][:1])
+    assert 0 < ref_r < s["worn_through"]["floor_m"] == pytest.approx(
+        s["worn_through_floor_m"]["disc"])
+    ts = np.genfromtxt(tmp_path / "timeseries.csv", delimiter=",", names=True)
+    assert ts.size == 2 and s["steps"] < setup.duration_s / s["dt_s"] / 5
+    with pytest.raises(RunStopped, match="disc was worn through"):
+        run_braking(setup, tmp_path, resume=True)
+    again = json.loads((tmp_path / "summary.json").read_text())
+    assert {k: v for k, v in again.items() if not k.startswith("wall_time")} == \
+        {k: v for k, v in s.items() if not k.startswith("wall_time")}
+    never = run_braking(_tiny({"worn_through_diameters": 0.0}), None)
+    assert never["status"] == "finished" and never["worn_through"] is None
 
 
 def test_quick_preset_overrides_the_config_file(tmp_path: Path) -> None:
@@ -629,7 +707,7 @@ def test_fixed_distance_run_through_the_installed_command(tmp_path: Path) -> Non
     from conftest import run_tribodem
 
     cfg = tmp_path / "d.toml"
-    cfg.write_text("[geometry]\nwidth_m = 144e-6\ndisc_height_m = 50e-6\npad_height_m = 50e-6\n"
+    cfg.write_text("[geometry]\nwidth_m = 144e-6\ndisc_height_m = 50e-6\npad_height_m = 108e-6\n"
                    "roughness_amplitude_m = 6e-6\nroughness_modes = 3\n"
                    "[run]\ndistance_m = 0.2e-3\nsamples = 20\nvtk_snapshots = 0\n"
                    "figures = false\n")
@@ -643,3 +721,10 @@ def test_fixed_distance_run_through_the_installed_command(tmp_path: Path) -> Non
     assert "distance_m = 0.0002" in (out / "config.toml").read_text()
     r = run_tribodem("braking", "run", "--out", str(out), "--resume", "--no-progress")
     assert r.returncode == 0 and "already finished" in r.stderr, r.stderr[-800:]
+    # a body worn through: exit 3, the body, the field to change, outputs kept
+    cfg.write_text(cfg.read_text() + "worn_through_diameters = 100\n")
+    r = run_tribodem("braking", "run", "--condition", "3", "--config", str(cfg), "--out",
+                     str(out), "--no-progress")
+    assert r.returncode == 3 and "disc was worn through" in r.stderr, r.stderr[-800:]
+    assert "disc_height_m" in r.stderr and "Traceback" not in r.stderr
+    assert json.loads((out / "summary.json").read_text())["status"] == "worn_through"

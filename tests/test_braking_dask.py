@@ -16,14 +16,14 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
-from conftest import TINY_CELL, run_tribodem, tribodem_exe
+from conftest import TINY_CELL, TINY_RUN, run_tribodem, tribodem_exe
 
 pytest.importorskip("distributed")
 
 SWEEP = f"""
 {TINY_CELL}
 [run]
-duration_s = 0.5e-6
+{TINY_RUN}duration_s = 0.5e-6
 samples = 8
 vtk_snapshots = 2
 figures = false

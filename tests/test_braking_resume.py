@@ -13,7 +13,7 @@ import time
 from pathlib import Path
 
 import pytest
-from conftest import TINY_CELL, default_sigint, run_tribodem, tribodem_exe
+from conftest import TINY_CELL, TINY_RUN, default_sigint, run_tribodem, tribodem_exe
 
 #: a tiny interface (~150 particles), ~17k steps per microsecond of sliding
 SMALL = f"""
@@ -22,7 +22,7 @@ index = 5
 
 {TINY_CELL}
 [run]
-duration_s = {{duration}}
+{TINY_RUN}duration_s = {{duration}}
 samples = 20
 vtk_snapshots = 3
 figures = false
@@ -195,7 +195,7 @@ def test_bad_inputs_are_refused_before_any_work(reference: tuple[Path, Path],
 SWEEP = f"""
 {TINY_CELL}
 [run]
-duration_s = 0.6e-6
+{TINY_RUN}duration_s = 0.6e-6
 samples = 8
 vtk_snapshots = 2
 figures = false

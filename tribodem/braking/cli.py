@@ -126,6 +126,12 @@ class RunCfg(_Strict):
         description="debris outlet: a debris component leaves the cell once carried this "
                     "far (m) along the sliding relative to the pad (residence length, e.g. "
                     "a pad plateau, 50-500 um); 0 = closed cell, as in seed 000")
+    worn_through_diameters: float = Field(
+        2.0, ge=0, le=1000,
+        description="stop the run (exit 3, outputs kept) when a body's remaining intact "
+                    "thickness outside its anchored layer falls below this many of its "
+                    "mean particle diameters (worn through: the boundary layer meets the "
+                    "interface); 0 = never stop")
     checkpoint_every: int = Field(
         0, ge=0, le=100_000,
         description="samples between checkpoints (checkpoint.npz in the output folder); "
@@ -148,8 +154,11 @@ class BrakingConfig(_Strict):
     thermal: ThermalCfg = ThermalCfg()
 
 
+#: the ``--quick`` preset: a narrower cell and a thinner disc than the defaults, 20 us. Its
+#: pad has the default height: a 50-um pad shattered under the first impacts at conditions
+#: 1-4 (worn through within 0.06-0.55 mm, docs/braking.md "Bodies worn through")
 QUICK: dict[str, Any] = {
-    "geometry": {"width_m": 144e-6, "disc_height_m": 50e-6, "pad_height_m": 50e-6,
+    "geometry": {"width_m": 144e-6, "disc_height_m": 50e-6, "pad_height_m": 108e-6,
                  "roughness_amplitude_m": 6e-6, "roughness_modes": 3},
     "run": {"duration_s": 20e-6, "distance_m": 0.0, "samples": 100, "vtk_snapshots": 4},
 }
@@ -210,7 +219,8 @@ def setup_from_config(cfg: BrakingConfig) -> Any:
                     figures=r.figures, checkpoint_every=r.checkpoint_every,
                     until_steady=r.until_steady, max_distance_m=r.max_distance_m,
                     steady_tolerance=r.steady_tolerance, ramp_s=r.ramp_s,
-                    speed_ramp_s=r.speed_ramp_s, outlet_length_m=r.outlet_length_m)
+                    speed_ramp_s=r.speed_ramp_s, outlet_length_m=r.outlet_length_m,
+                    worn_through_diameters=r.worn_through_diameters)
 
 
 #: config fields a resumed run may change (they do not change the results)

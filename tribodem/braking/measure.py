@@ -28,6 +28,11 @@ Definitions (reference state = the loaded interface at the start of sliding):
   the cell width and the packing fraction, ``h = sum(pi r^2) / (phi W)`` (m): the
   thickness of intact material removed, the area form of "vertical displacement of the
   detached material" (section 3.4). The seed's pad value is ``wear_depth_mean_m``.
+- **remaining thickness** (per body): the solid area of the body's matrix and
+  delaminated-layer particles outside its anchored layer over ``phi W`` (m): the mean
+  thickness of body left between the anchored boundary layer and the sliding interface
+  (a delaminated slab still stands between them and carries the load). ``run`` stops a
+  run whose body is worn through (``WORN_THROUGH``).
 - **wear depth, max** (per body): the deepest initial position of a worn particle's
   far edge below the body's initial mean surface (disc: ``s0 - (y0 - r)``; pad:
   ``(y0 + r) - s0``), clipped at 0; ``s0`` = mean over x-bins (2 r_max wide) of the
@@ -196,6 +201,8 @@ def measure(iface: Interface, ref: Reference, slid: float) -> dict[str, float]:
         out[f"delaminated_particles_{name}"] = float(lay.sum())
         out[f"delaminated_depth_{name}_m"] = float(area[lay].sum() / (ref.phi[body] * w))
         out[f"wear_depth_mean_{name}_m"] = float(area[d].sum() / (ref.phi[body] * w))
+        own = (matrix | layer) & (ref.group == body) & ~iface.anchors
+        out[f"remaining_thickness_{name}_m"] = float(area[own].sum() / (ref.phi[body] * w))
         dep = ref.depth(np.flatnonzero(d), edge=True)
         out[f"wear_depth_max_{name}_m"] = float(max(0.0, dep.max(initial=0.0)))
     b = iface.bonds

@@ -121,6 +121,9 @@ class RunSetup:
     #: debris outlet (``outlet``): a debris component leaves the cell once carried this
     #: far (m) along the sliding relative to the pad; 0 = closed cell (seed 000)
     outlet_length_m: float = 0.0
+    #: stop when a body's remaining thickness falls below this many of its mean particle
+    #: diameters (``WORN_THROUGH``); 0 = never stop
+    worn_through_diameters: float = 2.0
 
 
 class LoopStep(NamedTuple):
@@ -279,6 +282,32 @@ def _slope(x: np.ndarray, y: np.ndarray) -> float:
 STEADY_CUTS = (1.0, 0.9, 0.8)
 #: ``until_steady`` slides on in blocks of this fraction of ``duration_s`` between tests
 STEADY_BLOCK = 0.2
+#: a body is worn through when its remaining thickness (``measure``: intact matrix and
+#: delaminated slab outside the anchored layer, solid area over ``phi W``) falls below this
+#: many of its mean particle diameters (the default of ``RunSetup.worn_through_diameters``):
+#: the anchored boundary layer, not the body, then meets the sliding interface, so the cell
+#: no longer models the surface zone of a thick pad or disc. The run stops there (exit 3,
+#: every output written). With the debris outlet the bodies are consumed at the wear rate
+#: (session 29: the 72-um disc of the default cell within 5-12 mm in 9 of 22 runs)
+WORN_THROUGH = RunSetup.worn_through_diameters
+
+
+def worn_floor(ref: Reference, diameters: float = WORN_THROUGH) -> dict[str, float]:
+    """Per body ("disc", "pad") the remaining thickness (m) below which it is worn
+    through: ``diameters`` (``RunSetup.worn_through_diameters``) mean particle diameters
+    of that body (0: never)."""
+    return {name: diameters * 2.0 * float(ref.radius[ref.group == body].mean())
+            for body, name in ((DISC, "disc"), (PAD, "pad"))}
+
+
+def worn_through(row: dict[str, float], floor: dict[str, float]) -> dict[str, Any] | None:
+    """The first body worn through in a measurement row (``worn_floor``), or None."""
+    for name, f in floor.items():
+        left = row.get(f"remaining_thickness_{name}_m", float("inf"))
+        if left < f:
+            return {"body": name, "sliding_distance_m": row["sliding_distance_m"],
+                    "remaining_thickness_m": left, "floor_m": f}
+    return None
 
 
 def _thirds(s: np.ndarray, h: np.ndarray, tol: float) -> tuple[bool, float, float]:
@@ -362,9 +391,11 @@ def read_checkpoint(path: str | Path) -> dict[str, Any]:
 
 
 #: setup fields added after checkpoints were first written, with the value the run of an
-#: older checkpoint (which does not record them) had
+#: older checkpoint (which does not record them) had -- or, for the worn-through guard,
+#: resumes with (a run that had no guard gets the default one from its next sample on)
 ADDED_FIELDS: dict[tuple[str, ...], Any] = {("geometry", "first_mode"): 1,
-                                             ("outlet_length_m",): 0.0}
+                                             ("outlet_length_m",): 0.0,
+                                             ("worn_through_diameters",): 2.0}
 
 
 def check_resumable(rec: dict[str, Any], setup: RunSetup, path: str | Path) -> None:
@@ -466,7 +497,9 @@ def run_braking(setup: RunSetup, out: Path | None = None, *, resume: bool = Fals
     ``status = "stopped"`` are written. ``progress``: a bar over the sliding steps.
     ``config``: the command's resolved config (JSON-able), kept in the checkpoint.
     ``should_stop``: polled after every sample (a sweep's stop event); when it says yes the
-    run writes a checkpoint and stops (``RunStopped``), to be resumed later.
+    run writes a checkpoint and stops (``RunStopped``), to be resumed later. A body worn
+    through (``WORN_THROUGH``) ends the run at that sample: every output is written with
+    ``status = "worn_through"``, then ``RunStopped`` says which body and where.
     """
     for name, v in (("pressure_Pa", setup.pressure_Pa), ("speed_m_s", setup.speed_m_s),
                     ("duration_s", setup.duration_s)):
@@ -496,6 +529,7 @@ def run_braking(setup: RunSetup, out: Path | None = None, *, resume: bool = Fals
         _thermal(iface, setup, t0)
     start_sliding(iface, setup.speed_m_s)
     ref = reference(iface)
+    floor = worn_floor(ref, setup.worn_through_diameters)
     outlet = Outlet(iface, setup.outlet_length_m) if setup.outlet_length_m > 0 else None
     # outlet checks at most every quarter cell of disc travel (exact minimum images)
     outlet_every = max(1, int(0.25 * iface.width / (setup.speed_m_s * sim.dt)))
@@ -541,7 +575,8 @@ def run_braking(setup: RunSetup, out: Path | None = None, *, resume: bool = Fals
                "interface_force_N": interface_load(iface)}
         row.update(measure(iface, ref, slid))
         if rows and list(rows[0]) != list(row):  # a checkpoint of an older version
-            rows[:] = [{k: r.get(k, 0.0) for k in row} for r in rows]
+            rows[:] = [{k: r.get(k, float("nan") if k.startswith("remaining_") else 0.0)
+                        for k in row} for r in rows]
         rows.append({k: float(v) for k, v in row.items()})
         if out is not None and any(done >= s and s not in seen for s in vtk_at):
             for s in vtk_at:
@@ -632,7 +667,7 @@ def run_braking(setup: RunSetup, out: Path | None = None, *, resume: bool = Fals
     try:
         with runs.progress(total_steps, "step", "braking run", enabled=progress,
                            initial=done) as bar:
-            while True:
+            while not ended:
                 if done >= total_steps:
                     if (not setup.until_steady or done >= cap_steps or steady_state(
                             *_wear_vs_distance(rows), setup.steady_tolerance,
@@ -652,6 +687,9 @@ def run_braking(setup: RunSetup, out: Path | None = None, *, resume: bool = Fals
                             outlet.check(iface)
                 done += k
                 sample()
+                if worn_through(rows[-1], floor) is not None:
+                    ended = True  # the cell no longer models a thick body: stop here
+                    break
                 if "early" not in frames and done >= 0.1 * total_steps:
                     frames["early"] = _frame(iface, ref, slid_now())
                 bar.update(k)
@@ -695,8 +733,10 @@ def run_braking(setup: RunSetup, out: Path | None = None, *, resume: bool = Fals
     rate, h8 = wear_extrapolation(tt, hh, SEED_BRAKING_TIME_S)
     st = steady_state(*_wear_vs_distance(rows), setup.steady_tolerance, STEADY_CUTS)
     looks = max(loop.contact[0], 1.0)
+    worn = worn_through(last, floor)
     summary: dict[str, Any] = {
-        "status": "finished",
+        "status": "worn_through" if worn else "finished",
+        "worn_through": worn,
         "condition": setup.condition,
         "load_kN": pressure_to_load(setup.pressure_Pa),
         "pressure_Pa": setup.pressure_Pa,
@@ -723,6 +763,10 @@ def run_braking(setup: RunSetup, out: Path | None = None, *, resume: bool = Fals
             "delaminated_particles_disc", "delaminated_depth_disc_m",
             "ejected_particles_pad", "ejected_depth_pad_m", "ejected_particles_disc",
             "ejected_depth_disc_m")},
+        # nan when resumed from a finished checkpoint older than the column
+        **{k: last.get(k, float("nan")) for k in ("remaining_thickness_disc_m",
+                                                   "remaining_thickness_pad_m")},
+        "worn_through_floor_m": floor,
         "outlet_length_m": setup.outlet_length_m,
         "steady_wear_rate_m_s": rate,
         "wear_rate_steady_m_per_m": st["rate"],
@@ -786,6 +830,16 @@ def run_braking(setup: RunSetup, out: Path | None = None, *, resume: bool = Fals
             from tribodem.braking.plots import plot_run
 
             plot_run(out, rows, frames, iface, summary)
+    if worn:
+        raise RunStopped(
+            f"the {worn['body']} was worn through after "
+            f"{1e3 * worn['sliding_distance_m']:.3g} mm of sliding (remaining thickness "
+            f"{1e6 * worn['remaining_thickness_m']:.3g} um < "
+            f"{setup.worn_through_diameters:g} particle diameters = "
+            f"{1e6 * worn['floor_m']:.3g} um): the run stopped there, its outputs "
+            f"are written{' in ' + repr(str(out)) if out is not None else ''}; allowed: a "
+            f"thicker body ([geometry] {worn['body']}_height_m), a shorter run, or "
+            "[run] worn_through_diameters = 0 to slide on through the anchored layer")
     return summary
 
 
@@ -812,9 +866,19 @@ def _frame(iface: Interface, ref: Reference, slid: float) -> dict[str, np.ndarra
 
 
 def _outcome_notes(summary: dict[str, Any]) -> list[str]:
-    """What the run's own outcome means for its rates: an interface open for long spells
-    (``contact_fraction`` < ``CLOSED_CONTACT``), a steady-state rule that did not pass."""
+    """What the run's own outcome means for its rates: a body worn through, an interface
+    open for long spells (``contact_fraction`` < ``CLOSED_CONTACT``), a steady-state rule
+    that did not pass."""
     notes = []
+    worn = summary.get("worn_through")
+    if worn:
+        notes.append(
+            f"the {worn['body']} was worn through after "
+            f"{1e3 * worn['sliding_distance_m']:.3g} mm (less than "
+            f"{1e6 * worn['floor_m']:.3g} um of intact body left outside its anchored "
+            "layer): the run stopped there; every value is up to that point, and the cell "
+            "no longer models the surface zone of a thick body (docs/braking.md 'Bodies "
+            "worn through')")
     cf = summary["contact_fraction"]
     if cf < CLOSED_CONTACT:
         notes.append(

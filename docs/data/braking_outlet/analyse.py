@@ -12,7 +12,9 @@ steady-state rule (``tribodem.braking.run.steady_state`` with ``STEADY_CUTS``) t
 then every 20 % of that -- the distance where it first passes, and the contact fraction.
 Per condition: mean and sd/mean of the rates over the packings. Then the paired changes of
 the rate 13 -> 21 kN (condition 1 -> 5) and 800 -> 1200 r/min (3 -> 5) with their 95 %
-intervals (``tribodem.braking.compare``) beside the seed's. Markdown on stdout.
+intervals (``tribodem.braking.compare``) beside the seed's. Markdown on stdout. Runs made
+since session 29 also show the disc's wear rate and the intact thickness of each body left
+at the end (``remaining_thickness_*``; nan for older runs).
 """
 
 from __future__ import annotations
@@ -84,7 +86,10 @@ def reading(d: Path, start: float) -> dict[str, float]:
             "ejected": _slope(s[m], ej[m]), "rule": bool(sm["steady_reached"]),
             "pass_at": at, "pass_rate": rate_at, "contact": sm["contact_fraction"],
             "slid": float(s[-1]), "layer": float(ts["transfer_layer_thickness_m"][m].mean()),
-            "cpu": sm["wall_time_s"]}
+            "cpu": sm["wall_time_s"],
+            "left": [sm.get(f"remaining_thickness_{b}_m", float("nan")) for b in ("disc", "pad")],
+            "disc_rate": (_slope(s[m], ts["wear_depth_mean_disc_m"][m])
+                          if "wear_depth_mean_disc_m" in ts else float("nan"))}
 
 
 def sd_interval(x: np.ndarray) -> tuple[float, float, float]:
@@ -101,8 +106,9 @@ def main(pattern: str, conds: list[int], start: float) -> None:
     print(f"pattern {pattern}; packings {ks}; rates from {start * 1e3:g} mm\n")
     print("| condition | packing | slid mm | steady rate (last 2/3) um/mm | rate from "
           f"{start * 1e3:g} mm um/mm | ejected um/mm | rule on the whole run | until_steady "
-          "would stop at mm (rate um/mm) | contact fraction | transfer layer um | wall s |\n"
-          "|---|---|---|---|---|---|---|---|---|---|---|")
+          "would stop at mm (rate um/mm) | contact fraction | transfer layer um | wall s | "
+          "disc wear rate um/mm | intact disc / pad left at the end, um |\n"
+          "|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     for c in conds:
         for k, x in zip(ks, r[c], strict=True):
             stop = ("no pass" if not np.isfinite(x["pass_at"]) else
@@ -110,7 +116,9 @@ def main(pattern: str, conds: list[int], start: float) -> None:
             print(f"| {c} | {k} | {x['slid'] * 1e3:.2f} | {x['steady'] * 1e3:.2f} | "
                   f"{x['from'] * 1e3:.2f} | {x['ejected'] * 1e3:.2f} | "
                   f"{'steady' if x['rule'] else 'not steady'} | {stop} | "
-                  f"{x['contact']:.2f} | {x['layer'] * 1e6:.1f} | {x['cpu']:.0f} |")
+                  f"{x['contact']:.2f} | {x['layer'] * 1e6:.1f} | {x['cpu']:.0f} | "
+                  f"{x['disc_rate'] * 1e3:.2f} | {x['left'][0] * 1e6:.0f} / "
+                  f"{x['left'][1] * 1e6:.0f} |")
     print("\n| condition | steady rate um/mm: mean, sd/mean between packings (95 % interval) "
           f"| rate from {start * 1e3:g} mm: mean, sd/mean | within a run: sd/mean of "
           "the rates of 2-mm / 4-mm windows after the run-in | contact fraction (min-max) "

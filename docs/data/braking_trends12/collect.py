@@ -16,7 +16,8 @@ from pathlib import Path
 HERE = Path(__file__).parent
 COLUMNS = ("time_s", "sliding_distance_m", "wear_depth_mean_pad_m", "broken_bonds",
            "debris_particles", "transfer_layer_thickness_m", "interface_force_N",
-           "delaminated_particles_pad", "ejected_depth_pad_m")
+           "delaminated_particles_pad", "ejected_depth_pad_m", "wear_depth_mean_disc_m",
+           "remaining_thickness_disc_m", "remaining_thickness_pad_m")
 
 
 def collect(run: Path, to: Path = HERE) -> None:
