@@ -180,7 +180,7 @@ def compact_periodic(spec: MaterialSpec, width: float, height: float, seed: int,
     and a wall stress that fell from ~1 MPa to 7-26 kPa when relaxed further, i.e. the
     bisection had read transients). Stats: ``loose_fraction`` (particles without a
     neighbour within ``gap``, m; default the spec's bond gap) and ``relax_scale``.
-    A cell much taller than wide also closes slowly (216 x 576 um: 7-50 % loose in 4 of 8
+    A cell much taller than wide also closes slowly (216 x 592 um: 5-50 % loose in 5 of 8
     seeds): while more than ``LOOSE_MAX`` of the particles are loose, the compaction is
     made again from the same placement with relaxations 2x, 4x, 8x longer (packings that
     were jammed at once are unchanged). Returns (pos, radii, stats)."""
