@@ -577,6 +577,10 @@ def test_a_worn_through_body_stops_the_run(tmp_path: Path) -> None:
         {k: v for k, v in s.items() if not k.startswith("wall_time")}
     never = run_braking(_tiny({"worn_through_diameters": 0.0}), None)
     assert never["status"] == "finished" and never["worn_through"] is None
+    from tribodem.braking.cli import RunCfg
+    from tribodem.braking.run import WORN_THROUGH
+
+    assert RunCfg().worn_through_diameters == WORN_THROUGH  # the command's default
 
 
 def test_quick_preset_overrides_the_config_file(tmp_path: Path) -> None:

@@ -190,6 +190,7 @@ def measure(iface: Interface, ref: Reference, slid: float) -> dict[str, float]:
     out: dict[str, float] = {}
     area = np.pi * ref.radius**2
     w = ref.width
+    intact = (matrix | layer) & ~iface.anchors
     for body, name in ((DISC, "disc"), (PAD, "pad")):
         d = worn & (ref.group == body)
         out[f"worn_particles_{name}"] = float(d.sum())
@@ -201,7 +202,7 @@ def measure(iface: Interface, ref: Reference, slid: float) -> dict[str, float]:
         out[f"delaminated_particles_{name}"] = float(lay.sum())
         out[f"delaminated_depth_{name}_m"] = float(area[lay].sum() / (ref.phi[body] * w))
         out[f"wear_depth_mean_{name}_m"] = float(area[d].sum() / (ref.phi[body] * w))
-        own = (matrix | layer) & (ref.group == body) & ~iface.anchors
+        own = intact & (ref.group == body)
         out[f"remaining_thickness_{name}_m"] = float(area[own].sum() / (ref.phi[body] * w))
         dep = ref.depth(np.flatnonzero(d), edge=True)
         out[f"wear_depth_max_{name}_m"] = float(max(0.0, dep.max(initial=0.0)))

@@ -86,6 +86,19 @@ LOOP_KEY = "braking_loop"
 RESUME_FREE = ("checkpoint_every", "figures")
 
 
+#: a body is worn through when its remaining thickness (``measure``: intact matrix and
+#: delaminated slab outside the anchored layer, solid area over ``phi W``) falls below this
+#: many of its mean particle diameters (the default of ``RunSetup.worn_through_diameters``):
+#: the anchored boundary layer, not the body, then meets the sliding interface, so the cell
+#: no longer models the surface zone of a thick pad or disc. The run stops there (exit 3,
+#: every output written). With the debris outlet the bodies are consumed at the wear rate
+#: (session 29: the 72-um disc of the default cell within 5-12 mm in 9 of 22 runs)
+WORN_THROUGH = 2.0
+#: the measured columns added after checkpoints were first written whose rows of an older
+#: checkpoint are unknown (nan), not zero
+REMAINING = ("remaining_thickness_disc_m", "remaining_thickness_pad_m")
+
+
 @dataclass
 class RunSetup:
     """Everything a run needs (SI). ``condition`` is the table 4 index or ``None``."""
@@ -123,7 +136,7 @@ class RunSetup:
     outlet_length_m: float = 0.0
     #: stop when a body's remaining thickness falls below this many of its mean particle
     #: diameters (``WORN_THROUGH``); 0 = never stop
-    worn_through_diameters: float = 2.0
+    worn_through_diameters: float = WORN_THROUGH
 
 
 class LoopStep(NamedTuple):
@@ -282,14 +295,6 @@ def _slope(x: np.ndarray, y: np.ndarray) -> float:
 STEADY_CUTS = (1.0, 0.9, 0.8)
 #: ``until_steady`` slides on in blocks of this fraction of ``duration_s`` between tests
 STEADY_BLOCK = 0.2
-#: a body is worn through when its remaining thickness (``measure``: intact matrix and
-#: delaminated slab outside the anchored layer, solid area over ``phi W``) falls below this
-#: many of its mean particle diameters (the default of ``RunSetup.worn_through_diameters``):
-#: the anchored boundary layer, not the body, then meets the sliding interface, so the cell
-#: no longer models the surface zone of a thick pad or disc. The run stops there (exit 3,
-#: every output written). With the debris outlet the bodies are consumed at the wear rate
-#: (session 29: the 72-um disc of the default cell within 5-12 mm in 9 of 22 runs)
-WORN_THROUGH = RunSetup.worn_through_diameters
 
 
 def worn_floor(ref: Reference, diameters: float = WORN_THROUGH) -> dict[str, float]:
@@ -298,6 +303,14 @@ def worn_floor(ref: Reference, diameters: float = WORN_THROUGH) -> dict[str, flo
     of that body (0: never)."""
     return {name: diameters * 2.0 * float(ref.radius[ref.group == body].mean())
             for body, name in ((DISC, "disc"), (PAD, "pad"))}
+
+
+def _worn_text(worn: dict[str, Any]) -> str:
+    """The start of the sentence saying where a body was worn through (``worn_through``),
+    for the stop's message and the summary's note; its parenthesis is left open."""
+    return (f"the {worn['body']} was worn through after "
+            f"{1e3 * worn['sliding_distance_m']:.3g} mm of sliding (remaining thickness "
+            f"{1e6 * worn['remaining_thickness_m']:.3g} um < {1e6 * worn['floor_m']:.3g} um")
 
 
 def worn_through(row: dict[str, float], floor: dict[str, float]) -> dict[str, Any] | None:
@@ -395,7 +408,7 @@ def read_checkpoint(path: str | Path) -> dict[str, Any]:
 #: resumes with (a run that had no guard gets the default one from its next sample on)
 ADDED_FIELDS: dict[tuple[str, ...], Any] = {("geometry", "first_mode"): 1,
                                              ("outlet_length_m",): 0.0,
-                                             ("worn_through_diameters",): 2.0}
+                                             ("worn_through_diameters",): WORN_THROUGH}
 
 
 def check_resumable(rec: dict[str, Any], setup: RunSetup, path: str | Path) -> None:
@@ -575,7 +588,7 @@ def run_braking(setup: RunSetup, out: Path | None = None, *, resume: bool = Fals
                "interface_force_N": interface_load(iface)}
         row.update(measure(iface, ref, slid))
         if rows and list(rows[0]) != list(row):  # a checkpoint of an older version
-            rows[:] = [{k: r.get(k, float("nan") if k.startswith("remaining_") else 0.0)
+            rows[:] = [{k: r.get(k, float("nan") if k in REMAINING else 0.0)
                         for k in row} for r in rows]
         rows.append({k: float(v) for k, v in row.items()})
         if out is not None and any(done >= s and s not in seen for s in vtk_at):
@@ -764,8 +777,7 @@ def run_braking(setup: RunSetup, out: Path | None = None, *, resume: bool = Fals
             "ejected_particles_pad", "ejected_depth_pad_m", "ejected_particles_disc",
             "ejected_depth_disc_m")},
         # nan when resumed from a finished checkpoint older than the column
-        **{k: last.get(k, float("nan")) for k in ("remaining_thickness_disc_m",
-                                                   "remaining_thickness_pad_m")},
+        **{k: last.get(k, float("nan")) for k in REMAINING},
         "worn_through_floor_m": floor,
         "outlet_length_m": setup.outlet_length_m,
         "steady_wear_rate_m_s": rate,
@@ -832,11 +844,8 @@ def run_braking(setup: RunSetup, out: Path | None = None, *, resume: bool = Fals
             plot_run(out, rows, frames, iface, summary)
     if worn:
         raise RunStopped(
-            f"the {worn['body']} was worn through after "
-            f"{1e3 * worn['sliding_distance_m']:.3g} mm of sliding (remaining thickness "
-            f"{1e6 * worn['remaining_thickness_m']:.3g} um < "
-            f"{setup.worn_through_diameters:g} particle diameters = "
-            f"{1e6 * worn['floor_m']:.3g} um): the run stopped there, its outputs "
+            f"{_worn_text(worn)} = {setup.worn_through_diameters:g} particle diameters): "
+            "the run stopped there, its outputs "
             f"are written{' in ' + repr(str(out)) if out is not None else ''}; allowed: a "
             f"thicker body ([geometry] {worn['body']}_height_m), a shorter run, or "
             "[run] worn_through_diameters = 0 to slide on through the anchored layer")
@@ -873,12 +882,9 @@ def _outcome_notes(summary: dict[str, Any]) -> list[str]:
     worn = summary.get("worn_through")
     if worn:
         notes.append(
-            f"the {worn['body']} was worn through after "
-            f"{1e3 * worn['sliding_distance_m']:.3g} mm (less than "
-            f"{1e6 * worn['floor_m']:.3g} um of intact body left outside its anchored "
-            "layer): the run stopped there; every value is up to that point, and the cell "
-            "no longer models the surface zone of a thick body (docs/braking.md 'Bodies "
-            "worn through')")
+            f"{_worn_text(worn)} of intact body outside its anchored layer): the run "
+            "stopped there; every value is up to that point, and the cell no longer models "
+            "the surface zone of a thick body (docs/braking.md 'Bodies worn through')")
     cf = summary["contact_fraction"]
     if cf < CLOSED_CONTACT:
         notes.append(
