@@ -32,6 +32,7 @@ from tribodem.braking.model import (
     LOOSE_MAX,
     PAD,
     Geometry,
+    _pairs_periodic,
     build_interface,
     compact_periodic,
     materials,
@@ -231,6 +232,72 @@ def _free_chunk(it, xc: float, n: int) -> np.ndarray:
     chunk[pad[np.argsort(dx**2 + dy**2)[:n]]] = True
     b.mode[chunk[b.i] != chunk[b.j]] = TENSILE
     return chunk
+
+
+@pytest.mark.parametrize("body", ["pad", "disc"])
+def test_feed_continues_a_body_without_a_seam(body: str) -> None:
+    """One feed on the periodic-block cell at rest: the slab is the block's next band
+    placed exactly where a taller block would have it (the pad's rigid lowering), so its
+    bonds across the seam are exactly the block's y-periodic bonded pairs across its
+    period boundary (counted independently on the periodic block) and no pair overlaps
+    more than the block's own pairs do; the body's remaining thickness rises by exactly
+    the solid area of the slab outside its new anchored layer plus the former anchored
+    layer, over phi W (rel 1e-12); the plate moves out by the new face's offset."""
+    from tribodem.braking.feed import Feed
+    from tribodem.braking.measure import classify, measure, reference
+
+    iface = build_interface(SMALL, 0.53e6, block="periodic")
+    blk = iface.block
+    ref = reference(iface)
+    feed = Feed(iface, ref, "absorbing")
+    p = iface.sim.p
+    grp = PAD if body == "pad" else DISC
+    n0, nb0 = p.n, iface.bonds.n_bonds
+    old_anchor = (iface.anchor_pad if grp == PAD else iface.anchor_disc).copy()
+    top0 = float((p.pos[old_anchor, 1] + p.radius[old_anchor]).max())
+    wall0 = float(iface.wall.point[1])
+    before = measure(iface, ref, 0.0)[f"remaining_thickness_{body}_m"]
+    m = feed.apply(iface, body)
+    p = iface.sim.p
+    assert p.n == n0 + m and m > 10
+    # the block's own bonded pairs, periodic in y: those across its period boundary
+    # between the body's particles in the cell and the band the slab came from
+    gap = max(iface.disc.bond_gap, iface.pad.bond_gap)
+    i, j, _ = _pairs_periodic(blk.pos, blk.radius, blk.width, gap, height=blk.height)
+    cross = np.abs(blk.pos[j, 1] - blk.pos[i, 1]) > 0.5 * blk.height
+    ids = {tuple(q): k for k, q in enumerate(blk.pos)}
+    in_body = np.zeros(blk.radius.size, dtype=bool)
+    in_body[[ids[tuple(q)] for q in iface.block_pos[:n0][p.group[:n0] == grp]]] = True
+    band = (blk.pos[:, 1] < feed.slab) if grp == PAD else (
+        blk.pos[:, 1] >= blk.height - feed.slab)
+    expect = np.count_nonzero(cross & ((in_body[i] & band[j]) | (in_body[j] & band[i])))
+    b = iface.bonds
+    new_b = np.arange(nb0, b.n_bonds)
+    seam = new_b[(b.i[new_b] < n0) & (b.j[new_b] >= n0)]
+    assert seam.size == expect > 5
+    # overlaps across the seam: no larger than the block's
+    d = p.pos[b.j[new_b], :2] - p.pos[b.i[new_b], :2]
+    d[:, 0] -= blk.width * np.rint(d[:, 0] / blk.width)
+    ov = p.radius[b.i[new_b]] + p.radius[b.j[new_b]] - np.linalg.norm(d, axis=1)
+    d = blk.pos[j, :2] - blk.pos[i, :2]
+    d -= [blk.width, blk.height] * np.rint(d / [blk.width, blk.height])
+    assert ov.max() <= (blk.radius[i] + blk.radius[j] - np.linalg.norm(d, axis=1)).max() + 1e-15
+    # the remaining thickness, exactly
+    matrix, _ = classify(iface)
+    new = np.arange(n0, p.n)
+    anchors = iface.anchor_pad if grp == PAD else iface.anchor_disc
+    assert matrix[new].all() and not anchors[:n0].any() and anchors[new].any()
+    area = np.pi * p.radius**2
+    gain = (area[new[~anchors[new]]].sum() + area[:n0][old_anchor].sum()) / (iface.phi[grp]
+                                                                        * blk.width)
+    after = measure(iface, ref, 0.0)[f"remaining_thickness_{body}_m"]
+    assert after - before == pytest.approx(gain, rel=1e-12)
+    assert gain == pytest.approx(feed.slab, rel=0.3)
+    top1 = float((p.pos[anchors, 1] + p.radius[anchors]).max())
+    assert float(iface.wall.point[1]) - wall0 == (top1 - top0 if grp == PAD else 0.0)
+    if grp == PAD:
+        assert np.array_equal(iface.backing.idx, np.flatnonzero(anchors))
+    assert np.all(p.fixed[:n0][old_anchor] & (FIX_X | FIX_Y) == 0)
 
 
 def test_outlet_ejects_debris_after_its_residence_length() -> None:
@@ -476,6 +543,12 @@ def test_cli_refuses_bad_input(tmp_path: Path) -> None:
     r = _cli("run", "--condition", "5", "--config", str(bad), "--out", str(tmp_path / "t"))
     assert r.returncode == 2 and "worn_through_diameters" in r.stderr and "-1" in r.stderr
     assert "Traceback" not in r.stderr and not (tmp_path / "t").exists()
+    curve = tmp_path / "curve.csv"
+    curve.write_text("time_s,temperature_K\n0,300\n1,400\n")
+    bad.write_text(f"[run]\nfeed = true\n[thermal]\ncurve = '{curve}'\n")
+    r = _cli("run", "--condition", "5", "--config", str(bad), "--out", str(tmp_path / "s"))
+    assert r.returncode == 2 and "run.feed" in r.stderr and "thermal.curve" in r.stderr
+    assert "Traceback" not in r.stderr and not (tmp_path / "s").exists()
 
 
 def _tiny(change: dict | None = None) -> RunSetup:
@@ -487,26 +560,35 @@ def _tiny(change: dict | None = None) -> RunSetup:
     return RunSetup(**{**kw, **(change or {})})
 
 
-@pytest.mark.parametrize("change", [{}, {"outlet_length_m": 10e-6, "duration_s": 2e-6}],
-                         ids=["closed", "outlet"])
+OUTLET = {"outlet_length_m": 10e-6, "duration_s": 2e-6}
+
+
+@pytest.mark.parametrize("change", [{}, OUTLET, {**OUTLET, "feed": True}],
+                         ids=["closed", "outlet", "feed"])
 def test_resume_in_process_equals_the_uninterrupted_run(tmp_path: Path,
                                                         monkeypatch: pytest.MonkeyPatch,
                                                         change: dict) -> None:
     """Interrupted at the 8th sample (after the checkpoint of sample 6), then resumed:
     rows, pvd indexes, snapshots and summary are bitwise the uninterrupted run's; with
-    the debris outlet too (its travel and store state are in the checkpoint)."""
+    the debris outlet too (its travel and store state are in the checkpoint); with the
+    feed (slabs of one diameter, so that the tiny cell is fed once, after sample 8) the
+    run is interrupted at sample 12, after the feed's checkpoint, and the resume replays
+    the feed before loading it."""
+    import tribodem.braking.feed as feed_mod
     import tribodem.braking.run as run_mod
     from tribodem.braking.run import read_checkpoint
 
+    monkeypatch.setattr(feed_mod, "FEED_SLAB_DIAMETERS", 1.0)
     full = run_braking(_tiny(change), tmp_path / "a")
     if change:
         assert full["ejected_particles_disc"] + full["ejected_particles_pad"] > 0
+    stop = 12 if change.get("feed") else 8
     real = run_mod.measure
     calls = [0]
 
     def interrupted(*a: object, **k: object) -> dict:
         calls[0] += 1
-        if calls[0] == 8:
+        if calls[0] == stop:
             raise KeyboardInterrupt
         return real(*a, **k)
 
@@ -516,6 +598,9 @@ def test_resume_in_process_equals_the_uninterrupted_run(tmp_path: Path,
     monkeypatch.setattr(run_mod, "measure", real)
     rec = read_checkpoint(tmp_path / "b" / "checkpoint.npz")
     assert 0 < rec["done"] < rec["total_steps"] and not rec["finished"]
+    if change.get("feed"):
+        assert rec["feed"]["events"] == ["pad"] == [k for k, v in full["feed"][
+            "slabs_fed"].items() if v], rec["feed"]
     # checkpoint_every and figures may change on resume; the physics may not
     res = run_braking(_tiny({**change, "checkpoint_every": 5}), tmp_path / "b", resume=True)
     for k, v in full.items():
@@ -675,9 +760,11 @@ def test_braking_example_configs_resolve() -> None:
     from tribodem.braking.cli import _config, setup_from_config
 
     root = Path(__file__).resolve().parents[1] / "examples"
-    for name in ("braking_steady.toml", "braking_wide.toml", "braking_outlet.toml"):
+    for name in ("braking_steady.toml", "braking_wide.toml", "braking_outlet.toml",
+                 "braking_feed.toml"):
         s = setup_from_config(_config(5, root / name, False))
         assert s.until_steady and s.max_distance_m > 0, name
+    assert setup_from_config(_config(5, root / "braking_feed.toml", False)).feed
     assert setup_from_config(_config(5, root / "braking_outlet.toml", False)
                              ).outlet_length_m == pytest.approx(216e-6)
     # a fixed sliding distance: each condition slides 12 mm at its own speed (table 4)

@@ -203,6 +203,39 @@ def test_checkpoint_restores_bonds_and_log(tmp_path) -> None:
         assert sb.log == rb.log
 
 
+def test_appended_particles_and_bonds_leave_the_others_bitwise() -> None:
+    """``Simulation.append_particles`` + ``ParallelBonds.extend`` between steps: two held
+    particles appended far from the chain and bonded to each other leave the chain's run
+    bitwise as without them (indices, bond lists and the rebuilt neighbour list keep
+    every existing particle's order), and their bond starts at zero force and stays there
+    (no relative motion). An interaction that does not declare ``particles_appended``
+    refuses the growth."""
+    straight, sb = chain()
+    straight.step(500)
+    grown, gb = chain()
+    grown.step(150)
+    x = 0.05 + np.array([0.0, 2 * R + GAP])
+    idx = grown.append_particles(np.c_[x, np.zeros(2), np.zeros(2)], np.full(2, R),
+                                 np.full(2, 2500.0), np.zeros((2, 3)), np.zeros(2),
+                                 np.full(2, 7), np.full(2, FIX_TRANSLATION))
+    new = gb.extend(ParallelBonds(grown, idx[:1], idx[1:], LAM, E_BOND, KRATIO, SIGMA_T, COH))
+    assert list(idx) == [6, 7] and list(new) == [5] and grown.p.group[7] == 7
+    grown.step(350)
+    for arr in ("pos", "vel", "omega"):
+        assert np.array_equal(getattr(straight.p, arr), getattr(grown.p, arr)[:6]), arr
+    assert np.array_equal(sb.fn, gb.fn[:5]) and np.array_equal(sb.mode, gb.mode[:5])
+    assert gb.fn[5] == 0.0 and gb.intact[5] and sb.log == gb.log
+
+    class NoHook:
+        def compute(self, sim: Simulation) -> None:
+            pass
+
+    grown.add_interaction(NoHook())
+    with pytest.raises(ValueError, match="NoHook"):
+        grown.append_particles(np.zeros((1, 3)), [R], [2500.0], np.zeros((1, 3)), [0], [0],
+                               [0])
+
+
 def test_threaded_and_serial_kernels_agree_bitwise() -> None:
     """The serial pass sums each bond into its particles (Newton pairs); the threaded one
     stores the bonds and ``gather_bonds`` adds them in bond order: the same bits."""

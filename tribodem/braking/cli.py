@@ -132,6 +132,12 @@ class RunCfg(_Strict):
                     "thickness outside its anchored layer falls below this many of its "
                     "mean particle diameters (worn through: the boundary layer meets the "
                     "interface); 0 = never stop")
+    feed: bool = Field(
+        False, description="add a slab of fresh body behind a body's anchored layer "
+                           "whenever one slab's thickness has been worn (3 mean particle "
+                           "diameters), so slides can be longer than the bodies are thick "
+                           "(with outlet_length_m); the bodies are then cut from a block "
+                           "periodic in y (docs/braking.md 'Feed')")
     checkpoint_every: int = Field(
         0, ge=0, le=100_000,
         description="samples between checkpoints (checkpoint.npz in the output folder); "
@@ -209,6 +215,9 @@ def setup_from_config(cfg: BrakingConfig) -> Any:
         if not curve.is_file():
             raise ConfigError(f"braking: thermal.curve = '{curve}': file does not exist")
     r = cfg.run
+    if r.feed and curve is not None:
+        raise ConfigError(f"braking: run.feed = true with thermal.curve = '{curve}': the "
+                          "feed does not carry temperatures; allowed: one of the two")
     duration = r.distance_m / v if r.distance_m else r.duration_s
     return RunSetup(pressure_Pa=p, speed_m_s=v, duration_s=duration, geometry=geo,
                     condition=None if explicit else c.index, micro=r.micro, samples=r.samples,
@@ -220,7 +229,7 @@ def setup_from_config(cfg: BrakingConfig) -> Any:
                     until_steady=r.until_steady, max_distance_m=r.max_distance_m,
                     steady_tolerance=r.steady_tolerance, ramp_s=r.ramp_s,
                     speed_ramp_s=r.speed_ramp_s, outlet_length_m=r.outlet_length_m,
-                    worn_through_diameters=r.worn_through_diameters)
+                    worn_through_diameters=r.worn_through_diameters, feed=r.feed)
 
 
 #: config fields a resumed run may change (they do not change the results)

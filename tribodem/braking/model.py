@@ -120,6 +120,17 @@ class Geometry:
 
 
 @dataclass
+class Block:
+    """A compacted block periodic in x and y (``compact_periodic(periodic_y=True)``):
+    centres ``pos`` (m, y in [0, ``height``)), ``radius`` (m), the periods (m)."""
+
+    pos: np.ndarray
+    radius: np.ndarray
+    width: float
+    height: float
+
+
+@dataclass
 class Interface:
     """A built interface: the simulation, its bonds and the pressure wall, plus the
     bookkeeping the measurements need (groups, anchors, packing fraction)."""
@@ -136,6 +147,13 @@ class Interface:
     target_force: float
     stats: dict[str, float] = field(default_factory=dict)
     backing: PadBacking | None = None
+    #: the compacted block the bodies were cut from (``block = "periodic"`` only: the
+    #: source of the feed, ``braking.feed``) and each particle's place in it (m, (n, 3);
+    #: y in the block's periodic continuation, the pad before it was lowered)
+    block: Block | None = None
+    block_pos: np.ndarray | None = None
+    #: depth (m) of the anchored layers: one mean particle diameter of the cell
+    anchor_depth: float = 0.0
 
     @property
     def width(self) -> float:
@@ -148,17 +166,21 @@ class Interface:
         return self.anchor_disc | self.anchor_pad
 
 
-def _place_periodic(rng: np.random.Generator, radii: np.ndarray, w: float, h: float
-                    ) -> np.ndarray:
-    """Random sequential placement without overlap, periodic in x, in [0, w) x [r, h - r]."""
+def _place_periodic(rng: np.random.Generator, radii: np.ndarray, w: float, h: float,
+                    periodic_y: bool = False) -> np.ndarray:
+    """Random sequential placement without overlap, periodic in x, in [0, w) x [r, h - r]
+    (``periodic_y``: periodic in y too, in [0, w) x [0, h))."""
     pos = np.zeros((radii.size, 3))
     for k, r in enumerate(radii):
         for _ in range(20_000):
             x = rng.uniform(0.0, w)
-            y = rng.uniform(r, h - r)
+            y = rng.uniform(0.0, h) if periodic_y else rng.uniform(r, h - r)
             dx = pos[:k, 0] - x
             dx -= w * np.rint(dx / w)
-            if np.all(dx * dx + (pos[:k, 1] - y) ** 2 > (radii[:k] + r) ** 2):
+            dy = pos[:k, 1] - y
+            if periodic_y:
+                dy -= h * np.rint(dy / h)
+            if np.all(dx * dx + dy * dy > (radii[:k] + r) ** 2):
                 break
         else:
             raise RuntimeError(f"interface: could not place particle {k} of {radii.size}")
@@ -167,7 +189,8 @@ def _place_periodic(rng: np.random.Generator, radii: np.ndarray, w: float, h: fl
 
 
 def compact_periodic(spec: MaterialSpec, width: float, height: float, seed: int,
-                     stress: float = 1.0e6, max_iter: int = 40, gap: float | None = None
+                     stress: float = 1.0e6, max_iter: int = 40, gap: float | None = None,
+                     periodic_y: bool = False
                      ) -> tuple[np.ndarray, np.ndarray, dict[str, float]]:
     """A dense packing periodic in x between two walls (y = 0, y = ``height``): random
     placement, radius expansion in 10 stages, then a uniform radius scale (bracketing
@@ -183,18 +206,21 @@ def compact_periodic(spec: MaterialSpec, width: float, height: float, seed: int,
     A cell much taller than wide also closes slowly (216 x 592 um: 5-50 % loose in 5 of 8
     seeds): while more than ``LOOSE_MAX`` of the particles are loose, the compaction is
     made again from the same placement with relaxations 2x, 4x, 8x longer (packings that
-    were jammed at once are unchanged). Returns (pos, radii, stats)."""
+    were jammed at once are unchanged). ``periodic_y``: a block periodic in y too (no
+    walls; the stress is the contacts' mean normal stress, the virial sum of N d over
+    2 W H t), so that copies of it stacked in y continue it without a seam (the feed of
+    fresh body, ``braking.feed``); y in [0, ``height``). Returns (pos, radii, stats)."""
     gap = spec.bond_gap if gap is None else gap
     for longer in (1, 2, 4, 8):
         pos, radii, stats = _compact_once(spec, width, height, seed, stress, max_iter, gap,
-                                          longer)
+                                          longer, periodic_y)
         if stats["loose_fraction"] <= LOOSE_MAX:
             break
     return pos, radii, stats
 
 
 def _compact_once(spec: MaterialSpec, width: float, height: float, seed: int, stress: float,
-                  max_iter: int, gap: float, longer: int
+                  max_iter: int, gap: float, longer: int, periodic_y: bool = False
                   ) -> tuple[np.ndarray, np.ndarray, dict[str, float]]:
     """One compaction of ``compact_periodic`` with relaxations ``longer`` x its nominal
     steps."""
@@ -204,28 +230,39 @@ def _compact_once(spec: MaterialSpec, width: float, height: float, seed: int, st
     n = int(round(PHI_TARGET * width * height / mean_area))
     radii = np.sort(rng.uniform(rmin, rmax, size=n))[::-1].copy()
     f0 = math.sqrt(PHI0 / PHI_TARGET)
-    pos = _place_periodic(rng, radii * f0, width, height)
+    pos = _place_periodic(rng, radii * f0, width, height, periodic_y)
     t = spec.thickness
     mat = Material(name="compaction", young=spec.young, poisson=spec.poisson,
                    density=spec.density * MASS_SCALE, friction=0.0,
                    effective_modulus=spec.effective_modulus, kratio=1.0, beta_n=spec.beta_n,
                    law="linear")
-    box = Box([0.0, -2 * rmax, 0.0], [width, height + 2 * rmax, 0.0], [True, False, False])
+    if periodic_y:
+        box = Box([0.0, 0.0, 0.0], [width, height, 0.0], [True, True, False])
+    else:
+        box = Box([0.0, -2 * rmax, 0.0], [width, height + 2 * rmax, 0.0], [True, False, False])
 
-    scale = max(1, round(width / height)) * longer
+    scale = max(1, round(width / height)) * longer * (4 if periodic_y else 1)
 
     def relax(pos: np.ndarray, r: np.ndarray, steps: int) -> tuple[np.ndarray, float]:
-        walls = [PlaneWall([0, 0, 0], [0, 1, 0], name="bottom"),
-                 PlaneWall([0, height, 0], [0, -1, 0], name="top")]
+        walls = [] if periodic_y else [PlaneWall([0, 0, 0], [0, 1, 0], name="bottom"),
+                                       PlaneWall([0, height, 0], [0, -1, 0], name="top")]
         part = ParticleState(dim=2, pos=pos, radius=r, density=mat.density, thickness=t)
         sim = Simulation(part, [mat], box, walls=walls, local_damping=0.7, dt_safety=0.2)
         sim.step(steps * scale)
-        sig = 0.5 * (walls[0].normal_force + walls[1].normal_force) / (width * t)
+        if periodic_y:
+            c = sim.contacts()
+            dist = r[c["i"]] + r[c["j"]] - c["overlap"]
+            sig = float((c["normal_force"] * dist).sum()) / (2.0 * width * height * t)
+        else:
+            sig = 0.5 * (walls[0].normal_force + walls[1].normal_force) / (width * t)
         return sim.p.pos.copy(), sig
 
     pos, alpha, sig, n_iter = compact_by_radius_scaling(
         relax, pos, radii, f0, stress, spec.effective_modulus, max_iter, growth=1.004)
-    i, j, _ = _pairs_periodic(pos, radii * alpha, width, gap)
+    if periodic_y:
+        pos[:, 1] = np.mod(pos[:, 1], height)
+    i, j, _ = _pairs_periodic(pos, radii * alpha, width, gap,
+                              height if periodic_y else None)
     deg = np.bincount(np.concatenate([i, j]), minlength=n)
     return pos, radii * alpha, {"compaction_iterations": float(n_iter),
                                 "compaction_stress_Pa": float(sig),
@@ -259,12 +296,18 @@ def profile_height(x: np.ndarray, width: float, prof: tuple[np.ndarray, ...]) ->
                                 + ph)).sum(axis=1)
 
 
-def _pairs_periodic(pos: np.ndarray, radius: np.ndarray, width: float, gap: float
-                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Pairs (i < j) with surface gap < ``gap`` (m), periodic in x; returns (i, j, gap)."""
-    y0 = pos[:, 1].min()
-    span = float(np.ptp(pos[:, 1])) + 10 * float(radius.max()) + 1.0
-    pts = np.stack([np.mod(pos[:, 0], width), pos[:, 1] - y0 + 1e-9], axis=1)
+def _pairs_periodic(pos: np.ndarray, radius: np.ndarray, width: float, gap: float,
+                    height: float | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Pairs (i < j) with surface gap < ``gap`` (m), periodic in x (and in y with period
+    ``height`` when given); returns (i, j, gap)."""
+    if height is None:
+        y0 = pos[:, 1].min()
+        span = float(np.ptp(pos[:, 1])) + 10 * float(radius.max()) + 1.0
+        pts = np.stack([np.mod(pos[:, 0], width), pos[:, 1] - y0 + 1e-9], axis=1)
+    else:
+        span = height
+        pts = np.stack([np.mod(pos[:, 0], width), np.mod(pos[:, 1], height)], axis=1)
+        pts[pts[:, 1] >= height, 1] = 0.0  # mod's round-off at the period
     tree = cKDTree(pts, boxsize=[width, span])
     pairs = tree.query_pairs(2.0 * float(radius.max()) + max(gap, 0.0) + 1e-12,
                              output_type="ndarray")
@@ -274,6 +317,8 @@ def _pairs_periodic(pos: np.ndarray, radius: np.ndarray, width: float, gap: floa
     i, j = pairs[:, 0].astype(np.int64), pairs[:, 1].astype(np.int64)
     d = pos[j, :2] - pos[i, :2]
     d[:, 0] -= width * np.rint(d[:, 0] / width)
+    if height is not None:
+        d[:, 1] -= height * np.rint(d[:, 1] / height)
     g = np.linalg.norm(d, axis=1) - radius[i] - radius[j]
     keep = g < gap
     return i[keep], j[keep], g[keep]
@@ -352,6 +397,18 @@ class PadBacking:
         self._dv = np.zeros(idx.size)  # each dashpot's normal speed (m/s), reused
         self._out = np.zeros(1)  # the compiled form's reaction (N)
 
+    def set_anchors(self, idx: np.ndarray, width: float) -> None:
+        """Move the dashpots to the particles ``idx`` (a new top layer, ``braking.feed``):
+        each takes the tributary area ``W t / n`` of the new layer."""
+        scale = max(self.idx.size, 1) / max(idx.size, 1)
+        self.idx = np.asarray(idx, dtype=np.int64)
+        self.c_n *= scale
+        self.c_t *= scale
+        self._dv = np.zeros(self.idx.size)
+
+    def particles_appended(self, sim: Simulation, n_old: int) -> None:
+        """Engine hook: the dashpots keep their particles (``set_anchors`` moves them)."""
+
     def compute(self, sim: Simulation) -> None:
         """Add the dashpot forces; set the plate's drive to target minus their reaction."""
         if self._dv.size != self.idx.size:
@@ -391,12 +448,18 @@ class PadBacking:
 def build_interface(geometry: Geometry, pressure_Pa: float, micro: str = "calibrated",
                     wall_mass_ratio: float = 0.05, dt_safety: float = 0.3,
                     local_damping: float = 0.0, backing: str = "absorbing",
-                    plate_areal_mass: float | None = None) -> Interface:
+                    plate_areal_mass: float | None = None, block: str = "walls") -> Interface:
     """Build the figure 8 interface (see the module docstring) with the pressure target
     ``pressure_Pa x width x thickness`` (N). The plate's mass is ``plate_areal_mass``
     (kg/m^2) x W x t when given (the omitted pad and back plate), else
     ``wall_mass_ratio`` x the cell's pad mass. Particles start at rest; ``start_sliding``
-    sets the disc moving, the pressure plate then applies the pad."""
+    sets the disc moving, the pressure plate then applies the pad. ``block``: the block
+    the bodies are cut from is compacted between two walls (``"walls"``, section 3.1) or
+    periodic in y too (``"periodic"``: the disc's bottom face and the pad's top face are
+    then one seamless plane of the block, so copies of it continue either body without a
+    seam: the feed, ``braking.feed``)."""
+    if block not in ("walls", "periodic"):
+        raise ValueError(f"block = {block!r}: must be 'walls' or 'periodic'")
     if not pressure_Pa > 0:
         raise ValueError(f"pressure_Pa = {pressure_Pa!r}: must be > 0 Pa")
     if not 0 < wall_mass_ratio <= 1000:
@@ -414,7 +477,10 @@ def build_interface(geometry: Geometry, pressure_Pa: float, micro: str = "calibr
     # one block, compacted with the disc's stiffness (both materials differ by ~12% in E_c;
     # the packing geometry only is kept)
     gap = max(disc.bond_gap, pad.bond_gap)
-    pos, radii, stats = compact_periodic(disc, w, total, g.seed, g.compaction_stress, gap=gap)
+    periodic = block == "periodic"
+    pos, radii, stats = compact_periodic(disc, w, total, g.seed, g.compaction_stress, gap=gap,
+                                         periodic_y=periodic)
+    blk = Block(pos.copy(), radii.copy(), w, total) if periodic else None
     if stats["loose_fraction"] > LOOSE_MAX:
         warnings.warn(f"interface packing (seed {g.seed}, width {w:.4g} m): "
                       f"{100 * stats['loose_fraction']:.1f} % of the particles have no "
@@ -433,6 +499,7 @@ def build_interface(geometry: Geometry, pressure_Pa: float, micro: str = "calibr
     is_disc = y < hd
     is_pad = y > hp
     keep = is_disc | is_pad
+    src = np.flatnonzero(keep)  # each kept particle's index in the block
     pos, radii, is_pad = pos[keep], radii[keep], is_pad[keep]
     group = np.where(is_pad, PAD, DISC).astype(np.int32)
     # bonds: same-body pairs within the bond gap (section 3.1); bodies not bonded together
@@ -445,7 +512,8 @@ def build_interface(geometry: Geometry, pressure_Pa: float, micro: str = "calibr
     idx = np.cumsum(ok) - 1
     keep2 = ok[bi] & ok[bj]
     bi, bj = idx[bi[keep2]], idx[bj[keep2]]
-    pos, radii, group = pos[ok], radii[ok], group[ok]
+    pos, radii, group, src = pos[ok], radii[ok], group[ok], src[ok]
+    block_pos = blk.pos[src].copy() if blk is not None else None
     # pad down rigidly until the closest disc-pad surface gap is the clearance
     pd = group == PAD
     # braking starts with the pad applied to the already sliding disc: its lowest point a
@@ -493,7 +561,8 @@ def build_interface(geometry: Geometry, pressure_Pa: float, micro: str = "calibr
     phi = {DISC: phi_c, PAD: phi_c}
     return Interface(sim=sim, bonds=bonds, wall=wall, disc=disc, pad=pad, geometry=g,
                      anchor_disc=anchor_disc, anchor_pad=anchor_pad, phi=phi,
-                     target_force=target, stats=stats, backing=back)
+                     target_force=target, stats=stats, backing=back, block=blk,
+                     block_pos=block_pos, anchor_depth=dm)
 
 
 def cross_contacts(iface: Interface) -> int:

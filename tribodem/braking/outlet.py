@@ -68,6 +68,13 @@ class Outlet:
         self.tracking = np.array(a["outlet_tracking"], dtype=bool)
         self.shelf = np.array(a["outlet_shelf"], dtype=np.float64)
 
+    def grow(self, iface: Interface) -> None:
+        """Particles were appended (``braking.feed``): they are body, not tracked."""
+        n, k = iface.sim.p.n, self.travel.size
+        self.travel = np.concatenate([self.travel, np.zeros(n - k)])
+        self.last_x = np.concatenate([self.last_x, iface.sim.p.pos[k:, 0]])
+        self.tracking = np.concatenate([self.tracking, np.zeros(n - k, dtype=bool)])
+
     def check(self, iface: Interface) -> int:
         """Update the travel of the debris and eject the components that went
         ``length``; returns the number of particles ejected now."""

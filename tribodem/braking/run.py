@@ -52,6 +52,7 @@ import numpy as np
 from numba import njit
 
 from tribodem.braking.conditions import SEED_BRAKING_TIME_S, pressure_to_load, speed_to_rpm
+from tribodem.braking.feed import Feed
 from tribodem.braking.measure import Reference, force_chains, measure, reference
 from tribodem.braking.model import (
     DISC,
@@ -137,6 +138,9 @@ class RunSetup:
     #: stop when a body's remaining thickness falls below this many of its mean particle
     #: diameters (``WORN_THROUGH``); 0 = never stop
     worn_through_diameters: float = WORN_THROUGH
+    #: feed fresh body behind a worn one (``braking.feed``; the bodies are then cut from a
+    #: block periodic in y)
+    feed: bool = False
 
 
 class LoopStep(NamedTuple):
@@ -223,6 +227,9 @@ class _Loop:
         self.n += 1
         if self.ramp_steps and self.n <= self.ramp_steps:
             self.apply()
+
+    def particles_appended(self, sim: Any, n_old: int) -> None:
+        """Engine hook: the loop holds no per-particle state."""
 
     def compiled(self, sim: Any) -> LoopStep | None:
         """The compiled form (``LoopStep``) once the load and speed ramps are over (the
@@ -408,7 +415,8 @@ def read_checkpoint(path: str | Path) -> dict[str, Any]:
 #: resumes with (a run that had no guard gets the default one from its next sample on)
 ADDED_FIELDS: dict[tuple[str, ...], Any] = {("geometry", "first_mode"): 1,
                                              ("outlet_length_m",): 0.0,
-                                             ("worn_through_diameters",): WORN_THROUGH}
+                                             ("worn_through_diameters",): WORN_THROUGH,
+                                             ("feed",): False}
 
 
 def check_resumable(rec: dict[str, Any], setup: RunSetup, path: str | Path) -> None:
@@ -521,6 +529,8 @@ def run_braking(setup: RunSetup, out: Path | None = None, *, resume: bool = Fals
     if setup.thermal_time_map not in ("simulated", "stretched"):
         raise ValueError(f"thermal_time_map = {setup.thermal_time_map!r}: must be "
                          "'simulated' or 'stretched'")
+    if setup.feed and setup.thermal_curve is not None:
+        raise ValueError("feed with a thermal_curve: the feed does not carry temperatures")
     ck = out / CHECKPOINT if out is not None else None
     saved: dict[str, Any] | None = None
     if resume:
@@ -533,7 +543,8 @@ def run_braking(setup: RunSetup, out: Path | None = None, *, resume: bool = Fals
     t_wall = time.perf_counter()
     iface = build_interface(setup.geometry, setup.pressure_Pa, setup.micro,
                             setup.wall_mass_ratio, setup.dt_safety, setup.local_damping,
-                            setup.backing, setup.plate_areal_mass)
+                            setup.backing, setup.plate_areal_mass,
+                            block="periodic" if setup.feed else "walls")
     t_build = time.perf_counter() - t_wall
     sim = iface.sim
     n0 = sim.p.n
@@ -544,6 +555,7 @@ def run_braking(setup: RunSetup, out: Path | None = None, *, resume: bool = Fals
     ref = reference(iface)
     floor = worn_floor(ref, setup.worn_through_diameters)
     outlet = Outlet(iface, setup.outlet_length_m) if setup.outlet_length_m > 0 else None
+    feed = Feed(iface, ref, setup.backing) if setup.feed else None
     # outlet checks at most every quarter cell of disc travel (exact minimum images)
     outlet_every = max(1, int(0.25 * iface.width / (setup.speed_m_s * sim.dt)))
     speed_steps = int(math.ceil(setup.speed_ramp_s / sim.dt)) if setup.speed_ramp_s > 0 else 0
@@ -620,6 +632,7 @@ def run_braking(setup: RunSetup, out: Path | None = None, *, resume: bool = Fals
             "entries": entries, "chain_entries": chain_entries, "columns": cols,
             "frames": {k: sorted(v) for k, v in frames.items()},
             "finished": ended,
+            "feed": feed.state() if feed is not None else None,
             "wall_time_build_s": wall_before["build"],
             "wall_time_sliding_s": wall_before["sliding"] + time.perf_counter() - t_slide,
             "wall_time_s": wall_before["total"] + time.perf_counter() - t_wall,
@@ -637,6 +650,8 @@ def run_braking(setup: RunSetup, out: Path | None = None, *, resume: bool = Fals
 
     if saved is not None:
         assert ck is not None
+        if feed is not None:  # the particles and bonds the feeds added, then their state
+            feed.replay(iface, saved["feed"], outlet)
         try:
             sim.load_checkpoint(ck)
         except Exception as err:  # noqa: BLE001 - a foreign or damaged checkpoint
@@ -671,6 +686,8 @@ def run_braking(setup: RunSetup, out: Path | None = None, *, resume: bool = Fals
             for name in (CHECKPOINT, "summary.json"):
                 (out / name).unlink(missing_ok=True)
         sample()
+        if feed is not None:
+            feed.begin(rows[0])
         frames["start"] = _frame(iface, ref, 0.0)
         if out is not None:
             save_checkpoint()
@@ -703,6 +720,10 @@ def run_braking(setup: RunSetup, out: Path | None = None, *, resume: bool = Fals
                 if worn_through(rows[-1], floor) is not None:
                     ended = True  # the cell no longer models a thick body: stop here
                     break
+                if feed is not None:
+                    for body, slabs in feed.due(rows[-1]).items():
+                        for _ in range(slabs):
+                            feed.apply(iface, body, outlet)
                 if "early" not in frames and done >= 0.1 * total_steps:
                     frames["early"] = _frame(iface, ref, slid_now())
                 bar.update(k)
@@ -779,6 +800,7 @@ def run_braking(setup: RunSetup, out: Path | None = None, *, resume: bool = Fals
         # nan when resumed from a finished checkpoint older than the column
         **{k: last.get(k, float("nan")) for k in REMAINING},
         "worn_through_floor_m": floor,
+        "feed": feed.summary() if feed is not None else None,
         "outlet_length_m": setup.outlet_length_m,
         "steady_wear_rate_m_s": rate,
         "wear_rate_steady_m_per_m": st["rate"],
@@ -959,6 +981,12 @@ def _assumptions(setup: RunSetup) -> list[str]:
                  "outlet'")
     else:
         a.append("closed cell (the seed's): no debris leaves; the third body accumulates")
+    if setup.feed:
+        a.append("feed: the bodies are cut from a block compacted periodic in x and y; "
+                 "whenever a body's remaining thickness has fallen by one slab (3 mean "
+                 "particle diameters) a slab of the block's continuation is added behind "
+                 "its anchored layer, which moves to the slab's outer face (the surface "
+                 "zone of a thick pad and disc; summary 'feed'; docs/braking.md 'Feed')")
     if setup.thermal_curve is None:
         a.append("no temperature boundary (the seed's figure 9 curve is not given in the "
                  "text; over microseconds any 8 s curve changes by ~1e-6 of its range)")

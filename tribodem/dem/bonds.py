@@ -1083,6 +1083,33 @@ class ParallelBonds:
         ab = 0.5 * (alpha[self.i] + alpha[self.j])
         self.fn += np.where(self.intact, self.kn * self.area * ab * self.length * db, 0.0)
 
+    # ------------------------------------------------------------------ growing runs
+    def particles_appended(self, sim: Simulation, n_old: int) -> None:
+        """Engine hook (``Simulation.append_particles``): the bonds keep their indices;
+        the per-particle bond lists grow to the new particle count."""
+        self.n_particles = sim.p.n
+        self._index()
+
+    def extend(self, more: ParallelBonds) -> np.ndarray:
+        """Append the bonds of ``more`` (made on the same simulation, not added to it):
+        they start at zero force from the geometry ``more`` was made on. Returns the new
+        bonds' indices."""
+        if more.dim != self.dim:
+            raise ValueError("bonds: cannot extend disks' bonds with spheres' (or back)")
+        nb0 = self.n_bonds
+        for k in (*self._ARRAYS, "newly", "brk"):
+            setattr(self, k, np.concatenate([getattr(self, k), getattr(more, k)]))
+        self.n_particles = max(self.n_particles, more.n_particles)
+        self._index()
+        return np.arange(nb0, self.n_bonds)
+
+    def _index(self) -> None:
+        """The per-particle bond lists and the per-bond screens of the current arrays."""
+        self.cstart, self.cbond = bond_csr(self.i, self.j, self.n_particles)
+        self.gstart, self.gbond = bond_csr(self.i, self.j, self.n_particles, by_bond=True)
+        self.screen = bond_screen(self.area, self.rb, self.inertia)
+        self.kc = self._consts_3d()
+
     # ------------------------------------------------------------------ checkpoints
     _ARRAYS = ("i", "j", "rb", "area", "inertia", "polar", "kn", "ks", "tensile", "cohesion",
                "tan_phi", "length", "normal", "fn", "fs", "mb", "mt", "mode", "fbond", "tbi",
@@ -1108,10 +1135,7 @@ class ParallelBonds:
         nb = self.i.size
         self.newly = np.zeros(nb, dtype=np.int8)
         self.brk = np.zeros((nb, N_BREAK))
-        self.cstart, self.cbond = bond_csr(self.i, self.j, self.n_particles)
-        self.gstart, self.gbond = bond_csr(self.i, self.j, self.n_particles, by_bond=True)
-        self.screen = bond_screen(self.area, self.rb, self.inertia)
-        self.kc = self._consts_3d()
+        self._index()
         self.log = []
         for q in range(state["log_step"].size):
             f = {k: float(state[f"log_{k}"][q]) for k in self._LOG_F}

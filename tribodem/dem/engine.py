@@ -312,6 +312,11 @@ class Interaction(Protocol):
     its steps in one compiled loop while every interaction has one (and no
     ``after_advance`` hook, energy tracking, extra contact law or threaded kernel is in
     play); otherwise step by step in Python.
+
+    Particles added during a run (``Simulation.append_particles``): every interaction
+    must declare ``particles_appended(sim, n_old)`` (called after the engine's arrays
+    have grown from ``n_old`` to ``sim.p.n``; the new particles have the highest
+    indices); one without it cannot take part in such a run (``ValueError``).
     """
 
     def compute(self, sim: Simulation) -> None: ...
@@ -486,6 +491,68 @@ class Simulation:
         if every < 1:
             raise ValueError(f"recorder: every = {every!r}: must be >= 1 step")
         self.recorders.append((int(every), recorder))
+
+    def append_particles(self, pos: np.ndarray, radius: np.ndarray, density: np.ndarray,
+                         vel: np.ndarray, mat: np.ndarray, group: np.ndarray,
+                         fixed: np.ndarray) -> np.ndarray:
+        """Add particles between steps (SI; arrays of the new particles, ``pos``/``vel``
+        (k, 3)); they take the indices ``n .. n + k - 1``, start without spin, contact
+        history or force. The neighbour list is rebuilt at once (the history of the
+        existing pairs carried over) and every interaction's ``particles_appended`` hook
+        is called (``Interaction``). The time step is kept; the critical step is
+        computed again (contacts and every interaction's ``critical_step``) and a step
+        above it is refused (``TimeStepError``, the particles stay appended) unless
+        ``force_dt``. Returns the new indices."""
+        p = self.p
+        n_old = p.n
+        k = int(np.asarray(radius).size)
+        missing = [type(x).__name__ for x in self.interactions
+                   if not hasattr(x, "particles_appended")]
+        if missing:
+            raise ValueError(f"append_particles: interaction(s) {', '.join(missing)} hold "
+                             "per-particle state and cannot grow (no particles_appended)")
+        new = ParticleState(dim=p.dim, pos=pos, radius=radius, density=density,
+                            thickness=p.thickness, vel=vel, mat=mat, group=group, fixed=fixed)
+        for name, a in new.arrays().items():
+            setattr(p, name, np.concatenate([getattr(p, name), a]))
+        p.update_mass()
+        n = p.n
+        grow = lambda a: np.concatenate([a, np.zeros((k, *a.shape[1:]))])  # noqa: E731
+        self.force, self.torque = grow(self.force), grow(self.torque)
+        self.ext_force, self.ext_torque = grow(self.ext_force), grow(self.ext_torque)
+        self._wforce, self._wtorque = grow(self._wforce), grow(self._wtorque)
+        nw = len(self.walls)
+        self.wall_hist = np.concatenate([self.wall_hist, np.zeros((nw, k, HIST))], axis=1)
+        self.wall_info = np.concatenate([self.wall_info, np.zeros((nw, k, 4))], axis=1)
+        nblocks = (n + BLOCK - 1) // BLOCK
+        self._wsum = np.zeros((nblocks, nw, 5))
+        self.drift = np.zeros(nblocks)
+        old, old_hist = self.nl, self.hist
+        self.nl = neighbors.build(p.pos, p.radius, self.skin, self.box.lo, self.box.hi,
+                                  self.box.periodic, old.builds)
+        for inter in self._pair_filters:
+            self.nl = inter.filter_pairs(self.nl)
+        self.hist = np.zeros((self.nl.n_pairs, HIST))
+        start = np.concatenate([old.start, np.full(k, old.start[-1])])  # no old pairs
+        neighbors.transfer_history.pick(n)(start, old.pair_j, old_hist, self.nl.start,
+                                           self.nl.pair_j, self.hist)
+        self._alloc_pairs()
+        self._build_wall_list()
+        for inter in self.interactions:
+            inter.particles_appended(self, n_old)  # type: ignore[attr-defined]
+        crit, by = critical_step(p.density, p.radius, p.mass, p.inertia, p.mat,
+                                 self.nl.pair_i, self.nl.pair_j, self.pairtab, self.elin,
+                                 self.materials, p.dim, p.thickness, p.pos, self.walls,
+                                 self.skin)
+        for inter in self.interactions:
+            step = getattr(inter, "critical_step", None)
+            if step is not None and float(step(self)) < crit:
+                crit, by = float(step(self)), f"{type(inter).__name__} stiffness sqrt(m/k)"
+        self.dt_critical, self.dt_limit_by = crit, by
+        if self.dt > crit and not self.force_dt:
+            raise TimeStepError(f"append_particles: dt = {self.dt:.6g} s is above the new "
+                                f"critical time step {crit:.6g} s limited by {by}")
+        return np.arange(n_old, n)
 
     # ------------------------------------------------------------------ stepping
     def _build_wall_list(self, at: np.ndarray | None = None) -> None:
