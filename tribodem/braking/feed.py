@@ -31,10 +31,13 @@ checkpoint.
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from tribodem.braking.measure import Reference
 from tribodem.braking.model import DISC, EJECTED, PAD, Interface, _pairs_periodic
+from tribodem.braking.outlet import Outlet
 from tribodem.dem import ParallelBonds
 from tribodem.dem.state import FIX_X, FIX_Y
 
@@ -74,7 +77,7 @@ class Feed:
                 out[k] = int(lost // self.slab)
         return out
 
-    def apply(self, iface: Interface, body: str, outlet: object | None = None) -> int:
+    def apply(self, iface: Interface, body: str, outlet: Outlet | None = None) -> int:
         """Add one slab behind ``body`` ("disc" or "pad"); returns the particles added."""
         blk, bpos = iface.block, iface.block_pos
         assert blk is not None and bpos is not None
@@ -101,7 +104,7 @@ class Feed:
                          - (lab[:, 1] - rad).min())
             gone = p.group == EJECTED
             p.pos[gone, 1] -= drop
-            outlet.shelf[1] -= drop  # type: ignore[attr-defined]
+            outlet.shelf[1] -= drop
         spec = iface.pad if grp == PAD else iface.disc
         m = rad.size
         vel = np.tile(p.vel[old_anchor].mean(axis=0), (m, 1))
@@ -131,13 +134,13 @@ class Feed:
         iface.bonds.extend(ParallelBonds(sim, bi, bj, iface.disc.bond_lambda, spec.bond_E,
                                          spec.bond_kr, spec.tensile_strength, spec.cohesion))
         if grp == PAD and iface.backing is not None:
-            iface.backing.set_anchors(np.flatnonzero(anchors), w)
+            iface.backing.set_anchors(np.flatnonzero(anchors))
         r = self.ref
         r.pos = np.concatenate([r.pos, ext + self.ref_offset[body]])
         r.radius = np.concatenate([r.radius, rad])
         r.group = np.concatenate([r.group, np.full(m, grp, dtype=r.group.dtype)])
         if outlet is not None:
-            outlet.grow(iface)  # type: ignore[attr-defined]
+            outlet.grow(iface)
         self.fed[body] += 1
         self.events.append(body)
         return m
@@ -167,17 +170,16 @@ class Feed:
         ok &= keep[np.maximum(j - p.n, 0)] | (j < p.n)
         return i[ok], j[ok], keep
 
-    def state(self) -> dict[str, object]:
+    def state(self) -> dict[str, Any]:
         """JSON-able record (the loop's checkpoint record)."""
         return {"events": list(self.events), "start": dict(self.start)}
 
-    def replay(self, iface: Interface, rec: dict[str, object], outlet: object | None
-               ) -> None:
-        """Repeat the recorded feeds on a freshly built interface (before its checkpoint
-        is loaded: the particle and bond counts then match it)."""
-        for body in rec["events"]:  # type: ignore[union-attr]
+    def replay(self, iface: Interface, rec: dict[str, Any], outlet: Outlet | None) -> None:
+        """Repeat the recorded feeds (``state``) on a freshly built interface, before its
+        checkpoint is loaded: the particle and bond counts then match it."""
+        for body in rec["events"]:
             self.apply(iface, str(body), outlet)
-        self.start = {str(k): float(v) for k, v in rec["start"].items()}  # type: ignore[union-attr]
+        self.start = {str(k): float(v) for k, v in rec["start"].items()}
 
     def summary(self) -> dict[str, object]:
         """What the summary reports about the feed."""

@@ -192,7 +192,8 @@ def compact_periodic(spec: MaterialSpec, width: float, height: float, seed: int,
                      stress: float = 1.0e6, max_iter: int = 40, gap: float | None = None,
                      periodic_y: bool = False
                      ) -> tuple[np.ndarray, np.ndarray, dict[str, float]]:
-    """A dense packing periodic in x between two walls (y = 0, y = ``height``): random
+    """A dense packing periodic in x between two walls (y = 0, y = ``height``; or
+    periodic in y too, ``periodic_y`` below): random
     placement, radius expansion in 10 stages, then a uniform radius scale (bracketing
     bisection) until the mean wall stress is within a factor 2 of ``stress`` (Pa; section
     3.1, PFC's isotropic-stress installation). Frictionless, mass-scaled, local damping
@@ -397,7 +398,7 @@ class PadBacking:
         self._dv = np.zeros(idx.size)  # each dashpot's normal speed (m/s), reused
         self._out = np.zeros(1)  # the compiled form's reaction (N)
 
-    def set_anchors(self, idx: np.ndarray, width: float) -> None:
+    def set_anchors(self, idx: np.ndarray) -> None:
         """Move the dashpots to the particles ``idx`` (a new top layer, ``braking.feed``):
         each takes the tributary area ``W t / n`` of the new layer."""
         scale = max(self.idx.size, 1) / max(idx.size, 1)
