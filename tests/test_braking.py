@@ -249,7 +249,7 @@ def test_feed_continues_a_body_without_a_seam(body: str) -> None:
     iface = build_interface(SMALL, 0.53e6, block="periodic")
     blk = iface.block
     ref = reference(iface)
-    feed = Feed(iface, ref, "absorbing")
+    feed = Feed(iface, ref)
     p = iface.sim.p
     grp = PAD if body == "pad" else DISC
     n0, nb0 = p.n, iface.bonds.n_bonds

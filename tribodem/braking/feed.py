@@ -51,7 +51,7 @@ class Feed:
     each body's remaining thickness at the start (m) and its anchored layer's offset
     from the block at the reference (m)."""
 
-    def __init__(self, iface: Interface, ref: Reference, backing: str) -> None:
+    def __init__(self, iface: Interface, ref: Reference) -> None:
         if iface.block is None or iface.block_pos is None:
             raise ValueError("feed: the interface must be cut from a periodic block "
                              "(build_interface(block='periodic'))")
@@ -59,7 +59,6 @@ class Feed:
         self.fed = {"disc": 0, "pad": 0}
         self.events: list[str] = []
         self.start: dict[str, float] = {}
-        self.pad_fix = FIX_X if backing == "support" else 0
         self.ref_offset = {name: _offset(iface, name) for name in BODIES}
         self.ref = ref
 
@@ -90,6 +89,10 @@ class Feed:
         ext, rad = _band(blk.pos, blk.radius, h, lo, hi)
         bi, bj, keep = self._pairs(iface, ext, rad, grp, lo if grp == PAD else hi)
         ext, rad = ext[keep], rad[keep]  # particles without a bond are dropped (as built)
+        n0 = p.n  # the kept ones will take the indices n0, n0 + 1, ...
+        renum = np.cumsum(keep) - 1 + n0
+        bi = np.where(bi >= n0, renum[np.maximum(bi - n0, 0)], bi)
+        bj = np.where(bj >= n0, renum[np.maximum(bj - n0, 0)], bj)
         dm = iface.anchor_depth
         if grp == PAD:
             new_anchor = ext[:, 1] + rad > (ext[:, 1] + rad).max() - dm
@@ -97,7 +100,7 @@ class Feed:
             new_anchor = ext[:, 1] - rad < (ext[:, 1] - rad).min() + dm
         old_anchor = (iface.anchor_pad if grp == PAD else iface.anchor_disc).copy()
         lab = ext + _offset(iface, body)  # the slab as one piece: its own pairs exact
-        lab[:, 1] += _clearance(iface, lab, ext, rad, bi, bj, keep, 1.0 if grp == PAD else -1.0)
+        lab[:, 1] += _clearance(iface, lab, ext, rad, bi, bj, 1.0 if grp == PAD else -1.0)
         lab[:, 0] = np.mod(lab[:, 0], w)
         if grp == DISC and outlet is not None:  # the store stays below the disc's face
             drop = float((p.pos[old_anchor, 1] - p.radius[old_anchor]).min()
@@ -108,12 +111,13 @@ class Feed:
         spec = iface.pad if grp == PAD else iface.disc
         m = rad.size
         vel = np.tile(p.vel[old_anchor].mean(axis=0), (m, 1))
-        fix = np.where(new_anchor, (FIX_X | FIX_Y) if grp == DISC else self.pad_fix, 0)
+        # the new layer is held as the old one was (disc: x and y; pad: as its backing)
+        held = int(np.bitwise_or.reduce(p.fixed[old_anchor] & (FIX_X | FIX_Y)))
+        fix = np.where(new_anchor, held, 0)
         if grp == PAD:  # the plate meets the new face as it met the old one
             top_old = float((p.pos[old_anchor, 1] + p.radius[old_anchor]).max())
             top_new = float((lab[new_anchor, 1] + rad[new_anchor]).max())
             iface.wall.point[1] += top_new - top_old
-        n0 = p.n
         idx = sim.append_particles(lab, rad, np.full(m, spec.density), vel,
                                    np.full(m, 1 if grp == PAD else 0),
                                    np.full(m, grp), fix.astype(np.uint8))
@@ -127,10 +131,6 @@ class Feed:
         iface.anchor_disc = anchors if grp == DISC else np.concatenate(
             [iface.anchor_disc, none])
         iface.block_pos = np.concatenate([bpos, ext])
-        # bond ends: old particles keep their index, the kept new ones are renumbered
-        renum = np.cumsum(keep) - 1 + n0
-        bi = np.where(bi >= n0, renum[np.maximum(bi - n0, 0)], bi)
-        bj = np.where(bj >= n0, renum[np.maximum(bj - n0, 0)], bj)
         iface.bonds.extend(ParallelBonds(sim, bi, bj, iface.disc.bond_lambda, spec.bond_E,
                                          spec.bond_kr, spec.tensile_strength, spec.cohesion))
         if grp == PAD and iface.backing is not None:
@@ -164,11 +164,10 @@ class Feed:
         i, j = ids[i], ids[j]
         new = (i >= p.n) | (j >= p.n)
         i, j = i[new], j[new]
+        ends = np.concatenate([i, j])
         keep = np.zeros(rad.size, dtype=bool)
-        keep[np.concatenate([i, j])[np.concatenate([i, j]) >= p.n] - p.n] = True
-        ok = keep[np.maximum(i - p.n, 0)] | (i < p.n)
-        ok &= keep[np.maximum(j - p.n, 0)] | (j < p.n)
-        return i[ok], j[ok], keep
+        keep[ends[ends >= p.n] - p.n] = True
+        return i, j, keep
 
     def state(self) -> dict[str, Any]:
         """JSON-able record (the loop's checkpoint record)."""
@@ -204,7 +203,7 @@ def _band(pos: np.ndarray, radius: np.ndarray, height: float, lo: float, hi: flo
 
 
 def _clearance(iface: Interface, lab: np.ndarray, ext: np.ndarray, rad: np.ndarray,
-               bi: np.ndarray, bj: np.ndarray, keep: np.ndarray, out: float) -> float:
+               bi: np.ndarray, bj: np.ndarray, out: float) -> float:
     """Shift (m, signed ``out``: +y for the pad, -y for the disc) that sets the slab out
     until no pair across the seam overlaps more than it does in the block. The slab is
     placed as one piece by its body's anchored layer's mean displacement; the layer's
@@ -218,10 +217,8 @@ def _clearance(iface: Interface, lab: np.ndarray, ext: np.ndarray, rad: np.ndarr
     n = p.n
     assert iface.block_pos is not None
     w = iface.width
-    slot = np.cumsum(keep) - 1
-    a, b = (bi, bj)
-    cross = (a < n) & (b >= n)
-    o, q = a[cross], slot[b[cross] - n]
+    cross = (bi < n) & (bj >= n)  # (body, slab) pairs; slab particles numbered from n
+    o, q = bi[cross], bj[cross] - n
     if o.size == 0:
         return 0.0
     shift = 0.0

@@ -555,7 +555,7 @@ def run_braking(setup: RunSetup, out: Path | None = None, *, resume: bool = Fals
     ref = reference(iface)
     floor = worn_floor(ref, setup.worn_through_diameters)
     outlet = Outlet(iface, setup.outlet_length_m) if setup.outlet_length_m > 0 else None
-    feed = Feed(iface, ref, setup.backing) if setup.feed else None
+    feed = Feed(iface, ref) if setup.feed else None
     # outlet checks at most every quarter cell of disc travel (exact minimum images)
     outlet_every = max(1, int(0.25 * iface.width / (setup.speed_m_s * sim.dt)))
     speed_steps = int(math.ceil(setup.speed_ramp_s / sim.dt)) if setup.speed_ramp_s > 0 else 0

@@ -10,6 +10,7 @@ The engine knows nothing about brakes or fretting; applications compose it.
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 from typing import Protocol
 
@@ -527,17 +528,7 @@ class Simulation:
         nblocks = (n + BLOCK - 1) // BLOCK
         self._wsum = np.zeros((nblocks, nw, 5))
         self.drift = np.zeros(nblocks)
-        old, old_hist = self.nl, self.hist
-        self.nl = neighbors.build(p.pos, p.radius, self.skin, self.box.lo, self.box.hi,
-                                  self.box.periodic, old.builds)
-        for inter in self._pair_filters:
-            self.nl = inter.filter_pairs(self.nl)
-        self.hist = np.zeros((self.nl.n_pairs, HIST))
-        start = np.concatenate([old.start, np.full(k, old.start[-1])])  # no old pairs
-        neighbors.transfer_history.pick(n)(start, old.pair_j, old_hist, self.nl.start,
-                                           self.nl.pair_j, self.hist)
-        self._alloc_pairs()
-        self._build_wall_list()
+        self._rebuild()
         for inter in self.interactions:
             inter.particles_appended(self, n_old)  # type: ignore[attr-defined]
         crit, by = critical_step(p.density, p.radius, p.mass, p.inertia, p.mat,
@@ -546,8 +537,9 @@ class Simulation:
                                  self.skin)
         for inter in self.interactions:
             step = getattr(inter, "critical_step", None)
-            if step is not None and float(step(self)) < crit:
-                crit, by = float(step(self)), f"{type(inter).__name__} stiffness sqrt(m/k)"
+            dt_i = float(step(self)) if step is not None else math.inf
+            if dt_i < crit:
+                crit, by = dt_i, f"{type(inter).__name__} stiffness sqrt(m/k)"
         self.dt_critical, self.dt_limit_by = crit, by
         if self.dt > crit and not self.force_dt:
             raise TimeStepError(f"append_particles: dt = {self.dt:.6g} s is above the new "
@@ -589,14 +581,24 @@ class Simulation:
                 return
         elif self.drift.max(initial=0.0) <= 0.5 * self.skin:
             return
+        self._rebuild()
+
+    def _rebuild(self) -> None:
+        """Build the neighbour list now, carrying every listed pair's history over (the
+        old list may hold fewer particles: ``append_particles``'s have no old pairs), and
+        the near-wall list with it."""
+        n = self.p.n
         old, old_hist = self.nl, self.hist
+        start = old.start
+        if start.size < n + 1:
+            start = np.concatenate([start, np.full(n + 1 - start.size, start[-1])])
         self.nl = neighbors.build(self.p.pos, self.p.radius, self.skin, self.box.lo,
                                   self.box.hi, self.box.periodic, old.builds)
         for inter in self._pair_filters:
             self.nl = inter.filter_pairs(self.nl)
         self.hist = np.zeros((self.nl.n_pairs, HIST))
-        neighbors.transfer_history.pick(self.p.n)(old.start, old.pair_j, old_hist,
-                                                  self.nl.start, self.nl.pair_j, self.hist)
+        neighbors.transfer_history.pick(n)(start, old.pair_j, old_hist, self.nl.start,
+                                           self.nl.pair_j, self.hist)
         self._alloc_pairs()
         self.drift[:] = 0.0
         self._build_wall_list()
