@@ -195,6 +195,51 @@ def test_retries_halve_the_increments_then_the_penalty(tmp_path: Path,
     assert [w[0] for w in written] == ["job", "job_refine2"]
 
 
+def test_a_failed_deck_is_not_run_again(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A deck that did not converge leaves a ``.failed`` record (its key, ccx's message):
+    the same deck is skipped the next time (a resumed run goes on from the next attempt),
+    a changed deck runs, and a known failure as the last attempt raises with ccx's first
+    message and the record's path."""
+    from types import SimpleNamespace
+
+    from tribodem.contact.fe import jobs
+    from tribodem.contact.fe.ccx import CcxConvergenceError
+
+    ran: list[str] = []
+
+    def stand_in(deck: Path, **kw: object) -> SimpleNamespace:
+        ran.append(deck.name)
+        if "soft" not in deck.name:
+            raise CcxConvergenceError("ccx did not converge",
+                                      "*ERROR: increment size smaller than minimum", deck)
+        return SimpleNamespace(job=deck.with_suffix(""), cached=False)
+
+    monkeypatch.setattr(jobs, "run_ccx", stand_in)
+    text = {"body": "mesh A"}
+
+    def write(refine: int, name: str, scale: float) -> Path:
+        deck = tmp_path / f"{name}.inp"
+        deck.write_text(f"{text['body']} {refine} {scale}\n")
+        return deck
+
+    with pytest.raises(CcxConvergenceError):  # the cycle stops after one retry
+        jobs.run_job(write, 1, 1, 60.0, None)
+    assert ran == ["job.inp", "job_refine2.inp"]
+    assert (tmp_path / "job.failed").read_text().splitlines()[1].startswith(
+        "ccx did not converge (deck ")
+    ran.clear()
+    run, refine, scale, _, _ = jobs.run_job(write, 2, 1, 60.0, None)  # resumed, one more
+    assert ran == ["job_refine2_soft2.inp"] and (refine, scale) == (2, 0.5)
+    ran.clear()
+    with pytest.raises(CcxConvergenceError, match=r"not run again.*job_refine2\.failed"):
+        jobs.run_job(write, 1, 1, 60.0, None)
+    assert ran == []
+    text["body"] = "mesh B"  # another geometry: another deck, run again
+    with pytest.raises(CcxConvergenceError, match="increment size smaller than minimum$"):
+        jobs.run_job(write, 1, 1, 60.0, None)
+    assert ran == ["job.inp", "job_refine2.inp"]
+
+
 def test_cell_average_conserves_the_integral() -> None:
     xn = np.array([-2.0, -1.0, 0.0, 0.5, 1.0, 3.0])
     vn = np.array([0.0, 1.0, 3.0, 2.0, 1.0, 0.0])

@@ -988,8 +988,10 @@ def run_fretting(cfg: FrettingConfig, out: Path, echo: Any = None, resume: bool 
         fe_stop = isinstance(loop.solver, (FEContactSolver, BACKENDS["fe3d"])) and \
             "window" not in hist.stopped
         runs.announce(out, ck, resume_hint="see the deck and its .log, then add --resume to "
-                      "retry the cycle" if fe_stop else "a resume would stop at the same cycle:"
-                      " to go on, start a new run with a larger contact.window")
+                      "retry the cycle (a deck that did not converge is not run again: raise "
+                      "fe.retries, or delete its .failed file)" if fe_stop else
+                      "a resume would stop at the same cycle: to go on, start a new run with a "
+                      "larger contact.window")
         raise runs.RunStopped(f"{hist.stopped} (results.csv, summary.json and figures up "
                               f"to cycle {loop.cycles_done} are written)")
     return summary

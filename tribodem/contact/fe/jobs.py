@@ -32,7 +32,7 @@ from tribodem.contact.fe.ccx import (
     run_ccx,
 )
 from tribodem.contact.fe.deck import ContactSettings, FEMaterial
-from tribodem.io.results import write_csv
+from tribodem.io.results import write_csv, write_text
 
 
 @dataclass
@@ -123,6 +123,22 @@ def _to_cache(run: CcxRun, cache: Path, key: str) -> None:
         shutil.rmtree(tmp, ignore_errors=True)
 
 
+#: beside a deck that did not converge: its key (``_cache_key``) on the first line, then
+#: ccx's message. ``run_job`` does not run a deck with that key again (a resumed run goes
+#: on from the next attempt); delete the file to run it again (ccx with PARDISO on several
+#: threads sums in another order each run, so a failed deck may pass another time).
+FAILED_SUFFIX = ".failed"
+
+
+def _known_failure(deck: Path, key: str) -> str | None:
+    """ccx's message for ``deck`` if a deck with ``key`` failed to converge here before."""
+    rec = deck.with_suffix(FAILED_SUFFIX)
+    if not rec.is_file():
+        return None
+    first, _, message = rec.read_text().partition("\n")
+    return message if first == key else None
+
+
 def attempt_settings(attempt: int) -> tuple[int, float]:
     """(increment refinement, contact penalty scale) of ``run_job``'s attempt ``attempt`` (0:
     the job as configured): the retries halve the increments and the contact's penalty
@@ -142,8 +158,11 @@ def run_job(write: Callable[[int, str, float], Path], retries: int, threads: int
     ``job_refine2``, ``job_refine2_soft2``, ...) at that refinement and contact penalty scale
     and returns its path. ``cache``: a folder of finished jobs keyed by the deck's bytes and
     the ccx build; a deck found there is not run again, its outputs are copied into the job
-    folder (``CcxRun.cached``). Returns (the run, its refinement, its penalty scale,
-    seconds writing decks, seconds in ccx over all attempts)."""
+    folder (``CcxRun.cached``). A deck that did not converge leaves a ``FAILED_SUFFIX``
+    record beside it, and the same deck is not run again (the next attempt follows): a run
+    resumed after a stopped cycle, with more ``retries``, goes on where it stopped. Returns
+    (the run, its refinement, its penalty scale, seconds writing decks, seconds in ccx over
+    all attempts)."""
     t_deck = t_ccx = 0.0
     for attempt in range(retries + 1):
         refine, scale = attempt_settings(attempt)
@@ -153,16 +172,24 @@ def run_job(write: Callable[[int, str, float], Path], retries: int, threads: int
         t1 = time.perf_counter()
         deck = write(refine, name, scale)
         t_deck += time.perf_counter() - t1
+        key = _cache_key(deck, executable)
         if cache is not None:
-            key = _cache_key(deck, executable)
             hit = _from_cache(deck, cache, key)
             if hit is not None:
                 return hit, refine, scale, t_deck, t_ccx
+        known = _known_failure(deck, key)
+        if known is not None:  # this very deck failed here before: the next attempt
+            if attempt == retries:
+                raise CcxConvergenceError(
+                    "ccx did not converge on this same deck before (not run again; delete "
+                    f"{deck.with_suffix(FAILED_SUFFIX)} to retry it)", known, deck)
+            continue
         t2 = time.perf_counter()
         try:
             run = run_ccx(deck, threads=threads, timeout=timeout, executable=executable)
-        except CcxConvergenceError:
+        except CcxConvergenceError as err:
             t_ccx += time.perf_counter() - t2
+            write_text(deck.with_suffix(FAILED_SUFFIX), f"{key}\n{err}")
             if attempt == retries:
                 raise
             continue
