@@ -198,6 +198,18 @@ def test_fe3d_refuses_other_geometries(tmp_path: Path) -> None:
         _solver(tmp_path, mode="chained")
 
 
+def test_fe3d_takes_the_mesh_fields_the_config_sets() -> None:
+    """[fe] h_over_a / size_factor left out: fe3d's own h = a/3, bodies 8 a; set, even to
+    the 2D backend's defaults (0.25, 40), they are taken (a/4 ran as a/3 until session 32)."""
+    from tribodem.fretting.cli import FrettingConfig, build_solver
+
+    own = build_solver(FrettingConfig.model_validate({"solver": "fe3d"}))
+    assert (own.h_over_a, own.size_factor) == (pytest.approx(1 / 3), 8.0)
+    set_ = build_solver(FrettingConfig.model_validate(
+        {"solver": "fe3d", "fe": {"h_over_a": 0.25, "size_factor": 10.0}}))
+    assert (set_.h_over_a, set_.size_factor) == (0.25, 10.0)
+
+
 # --- one coarse ccx job: the loading and a gross-slip cycle -----------------------------------
 
 @pytest.fixture(scope="module")

@@ -56,6 +56,7 @@ def test_compare_and_ranking() -> None:
              "cycles_to_first_wear_upper_centre": float("inf")},
             {"stage": "dfdi", "skipped": "no plastic strain"}]
     t = {(r["stage"], r["quantity"]): r for r in compare(rows)}
+    assert t[("dfdi", "max_dfdi_lower")]["ours"] is None
     assert abs(t[("von_mises", "mean_scar_depth_lower_m")]["ratio"] - 1.1) < 1e-12
     assert t[("von_mises", "mean_scar_depth_lower_m")]["within_20pct"] is True
     assert t[("dfdi", "mean_scar_depth_lower_m")]["ours"] is None
@@ -74,6 +75,19 @@ def test_compare_and_ranking() -> None:
     t = {(r["stage"], r["quantity"]): r for r in compare([*rows, s22])}
     assert t[("s22", "mean_scar_depth_lower_m")]["ours"] is None
     assert ranking([*rows, s22]) == ["von_mises", "energy", "swt"]
+
+
+def test_dfdi_peaks_beside_the_seeds() -> None:
+    """The DFDI stage reports its largest damage indicators beside the seed's ~6 / ~4."""
+    summary = {"cycles": 1, "cycles_simulated": 1, "wear_depth_mean_scar_lower_m": 3e-6,
+               "wear_depth_mean_scar_upper_m": 0.0, "wear_depth_lower_m": 5e-5,
+               "wear_depth_upper_m": 0.0, "wear_volume_lower_m3": 1e-13, "wall_time_s": 1.0,
+               "criterion_last_cycle": {"max_dfdi_lower": 1.2, "max_dfdi_upper": 0.48}}
+    row = row_of(Stage("dfdi", "dfdi", 1), summary)
+    t = {(r["stage"], r["quantity"]): r for r in compare([row])}
+    assert t[("dfdi", "max_dfdi_lower")]["ratio"] == pytest.approx(0.2)
+    assert t[("dfdi", "max_dfdi_upper")]["ratio"] == pytest.approx(0.12)
+    assert t[("dfdi", "max_dfdi_upper")]["within_20pct"] is False
 
 
 def test_jump_reading_reaches_study_md(tmp_path: Path) -> None:
