@@ -418,6 +418,40 @@ def test_ccx_failure_stops_the_run_with_exit_3(tmp_path: Path) -> None:
     assert "NOSUCHSET" not in (out / "fe" / "cycle_0002" / "job.inp").read_text()
 
 
+@needs_ccx
+def test_a_ccx_job_over_its_time_limit_stops_with_the_setting_named(tmp_path: Path) -> None:
+    """A job killed by ``fe.timeout`` (here cycle 2's, held up by a wrapper that sleeps
+    first) stops the run with exit 3, the limit and the setting to raise; the resume with a
+    larger limit (``fe.timeout`` may change on resume) finishes the run."""
+    real = shutil.which("ccx")
+    assert real is not None
+    bin_dir = tmp_path / "bin"
+    bin_dir.mkdir()
+    wrapper = bin_dir / "ccx"
+    wrapper.write_text("#!/bin/sh\ncase \"$PWD\" in */cycle_0002) sleep 120;; esac\n"
+                       f"exec {real} \"$@\"\n")
+    wrapper.chmod(wrapper.stat().st_mode | stat.S_IEXEC)
+    cfg = tmp_path / "fe.toml"
+    cfg.write_text(CONFIG.replace("[fe]\n", "[fe]\ntimeout = 30\n"))
+    out = tmp_path / "run"
+    env = dict(os.environ, PATH=f"{bin_dir}{os.pathsep}{os.environ['PATH']}",
+               TRIBODEM_CCX="ccx")
+    r = run_tribodem("fretting", "run", "--config", str(cfg), "--out", str(out),
+                     "--no-progress", env=env)
+    assert r.returncode == 3, r.stderr
+    assert "Traceback" not in r.stderr
+    assert "30 s wall-clock limit" in r.stderr
+    assert "raise fe.timeout (now 30 s)" in r.stderr
+    rows = (out / "results.csv").read_text().splitlines()
+    assert len(rows) == 2 and rows[1].startswith("1,")
+    cfg.write_text(CONFIG)  # the backend's own limit
+    r = run_tribodem("fretting", "run", "--config", str(cfg), "--out", str(out), "--resume",
+                     "--no-progress")
+    assert r.returncode == 0, r.stderr
+    rows = (out / "results.csv").read_text().splitlines()
+    assert [ln.split(",")[0] for ln in rows[1:]] == ["1", "2"]
+
+
 def test_missing_ccx_exits_2_with_the_install_command(tmp_path: Path) -> None:
     cfg = tmp_path / "fe.toml"
     cfg.write_text(CONFIG)

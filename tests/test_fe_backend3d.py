@@ -208,6 +208,11 @@ def test_fe3d_takes_the_mesh_fields_the_config_sets() -> None:
     set_ = build_solver(FrettingConfig.model_validate(
         {"solver": "fe3d", "fe": {"h_over_a": 0.25, "size_factor": 10.0}}))
     assert (set_.h_over_a, set_.size_factor) == (0.25, 10.0)
+    # the ccx time limit: the backend's own unless set (fe3d's seed cycle is ~1 h with
+    # Debian's ccx)
+    assert (own.timeout, set_.timeout) == (14400.0, 14400.0)
+    two = build_solver(FrettingConfig.model_validate({"solver": "fe3d", "fe": {"timeout": 60}}))
+    assert two.timeout == 60.0
 
 
 # --- one coarse ccx job: the loading and a gross-slip cycle -----------------------------------

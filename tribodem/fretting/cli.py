@@ -325,7 +325,10 @@ class FEConfig(_Model):
                                "half-width or radius (fe: >= 10; fe3d: its default 8, at "
                                "most R / (2 a))")
     threads: int = Field(1, ge=0, description="ccx threads (0 = all cores; --threads)")
-    timeout: float = Field(1800.0, gt=0, description="wall-clock limit of one ccx job, s")
+    timeout: float | None = Field(
+        None, gt=0, description="wall-clock limit of one ccx job, s (left out: the "
+        "backend's, fe 1800 s, fe3d 14400 s: the seed's 3D cycle takes ~1 h with Debian's "
+        "ccx on 2 threads, ~40 min at h = a/4 with ccx_pardiso)")
     retries: int = Field(1, ge=0, le=4, description="retries after a non-convergence: "
                          "halved increments, then also a contact half as stiff, alternately "
                          "(jobs.attempt_settings; 1: halved increments only)")
@@ -763,6 +766,8 @@ def build_solver(cfg: FrettingConfig) -> FirstBodySolver:
             # (even to those values), its own apply (h = a/3, bodies 8 a)
             fe = {k: v for k, v in fe.items() if k not in ("h_over_a", "size_factor")
                   or k in cfg.fe.model_fields_set}
+        if fe["timeout"] is None:  # the backend's own limit
+            del fe["timeout"]
         fe["threads"] = runs.check_threads(fe["threads"], "fe.threads (--threads)")
         takes = inspect.signature(backend).parameters
         for k in [k for k in fe if k not in takes]:  # an [fe] field this backend lacks
@@ -988,9 +993,13 @@ def run_fretting(cfg: FrettingConfig, out: Path, echo: Any = None, resume: bool 
     if hist.stopped:
         fe_stop = isinstance(loop.solver, (FEContactSolver, BACKENDS["fe3d"])) and \
             "window" not in hist.stopped
-        runs.announce(out, ck, resume_hint="see the deck and its .log, then add --resume to "
+        timed_out = fe_stop and "wall-clock limit" in hist.stopped
+        runs.announce(out, ck, resume_hint=(
+                      f"raise fe.timeout (now {loop.solver.timeout:g} s) and add --resume to "
+                      "the same command" if timed_out else
+                      "see the deck and its .log, then add --resume to "
                       "retry the cycle (a deck that did not converge is not run again: raise "
-                      "fe.retries, or delete its .failed file)" if fe_stop else
+                      "fe.retries, or delete its .failed file)") if fe_stop else
                       "a resume would stop at the same cycle: to go on, start a new run with a "
                       "larger contact.window")
         raise runs.RunStopped(f"{hist.stopped} (results.csv, summary.json and figures up "

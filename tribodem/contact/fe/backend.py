@@ -224,7 +224,7 @@ class FEContactSolver(CcxJobs, FirstBodySolver):
         h_over_a: float = FRETTING_H_OVER_A,
         size_factor: float = 40.0,
         threads: int = 1,
-        timeout: float = 900.0,
+        timeout: float = 1800.0,
         retries: int = 1,
         cache: str | Path | None = None,
         workdir: str | Path | None = None,

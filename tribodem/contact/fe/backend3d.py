@@ -337,7 +337,7 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         size_factor: float = FRETTING3D_SIZE_FACTOR,
         growth: float = FRETTING3D_GROWTH,
         threads: int = 1,
-        timeout: float = 1800.0,
+        timeout: float = 14400.0,
         retries: int = 1,
         cache: str | Path | None = None,
         max_wear_slope: float | None = CONVERGED_SLOPE,
