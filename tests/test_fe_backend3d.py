@@ -198,21 +198,19 @@ def test_fe3d_refuses_other_geometries(tmp_path: Path) -> None:
         _solver(tmp_path, mode="chained")
 
 
-def test_fe3d_takes_the_mesh_fields_the_config_sets() -> None:
-    """[fe] h_over_a / size_factor left out: fe3d's own h = a/3, bodies 8 a; set, even to
-    the 2D backend's defaults (0.25, 40), they are taken (a/4 ran as a/3 until session 32)."""
+def test_fe3d_mesh_fields_and_time_limit_from_the_config() -> None:
+    """[fe] h_over_a / size_factor at the 2D backend's defaults (0.25, 40): fe3d's own h =
+    a/3, bodies 8 a (a checkpoint's config records every field, so 0.25 set and left out
+    are one); other values are taken. The ccx time limit: the backend's own (4 h) unless
+    set."""
     from tribodem.fretting.cli import FrettingConfig, build_solver
 
     own = build_solver(FrettingConfig.model_validate({"solver": "fe3d"}))
     assert (own.h_over_a, own.size_factor) == (pytest.approx(1 / 3), 8.0)
     set_ = build_solver(FrettingConfig.model_validate(
-        {"solver": "fe3d", "fe": {"h_over_a": 0.25, "size_factor": 10.0}}))
-    assert (set_.h_over_a, set_.size_factor) == (0.25, 10.0)
-    # the ccx time limit: the backend's own unless set (fe3d's seed cycle is ~1 h with
-    # Debian's ccx)
-    assert (own.timeout, set_.timeout) == (14400.0, 14400.0)
-    two = build_solver(FrettingConfig.model_validate({"solver": "fe3d", "fe": {"timeout": 60}}))
-    assert two.timeout == 60.0
+        {"solver": "fe3d", "fe": {"h_over_a": 0.2499, "size_factor": 10.0, "timeout": 60}}))
+    assert (set_.h_over_a, set_.size_factor) == (0.2499, 10.0)
+    assert (own.timeout, set_.timeout) == (14400.0, 60.0)
 
 
 # --- one coarse ccx job: the loading and a gross-slip cycle -----------------------------------

@@ -320,7 +320,7 @@ class FEConfig(_Model):
         "increments per cycle (32 converged where 16 stalled, docs/fe.md)")
     h_over_a: float = Field(0.25, gt=0, le=1, description="element size at the contact / "
                             "Hertz half-width (docs/fe.md: a/4 is 4x faster than a/8 at "
-                            "large strokes; fe3d: left out, its own 1/3)")
+                            "large strokes; fe3d: at 0.25, its own 1/3; a/4 is 0.2499)")
     size_factor: float = Field(40.0, ge=2, le=200, description="bodies' size / contact "
                                "half-width or radius (fe: >= 10; fe3d: its default 8, at "
                                "most R / (2 a))")
@@ -761,11 +761,12 @@ def build_solver(cfg: FrettingConfig) -> FirstBodySolver:
         kw["contact"] = geo.contact
     if backend in (FEContactSolver, BACKENDS["fe3d"]):
         fe = cfg.fe.model_dump()
-        if backend is not FEContactSolver:  # fe3d: the [fe] mesh fields' 2D defaults
-            # (h = a/4, bodies 40 a) do not fit the 3D model: unless the config sets them
-            # (even to those values), its own apply (h = a/3, bodies 8 a)
+        if backend is not FEContactSolver:  # fe3d: the [fe] mesh fields at their 2D
+            # defaults (h = a/4, bodies 40 a) do not fit the 3D model: its own apply (h =
+            # a/3, bodies 8 a). A checkpoint's config records every field, so "set to 0.25"
+            # and "left out" cannot be told apart there: a/4 is asked for as 0.2499
             fe = {k: v for k, v in fe.items() if k not in ("h_over_a", "size_factor")
-                  or k in cfg.fe.model_fields_set}
+                  or v != type(cfg.fe).model_fields[k].default}
         if fe["timeout"] is None:  # the backend's own limit
             del fe["timeout"]
         fe["threads"] = runs.check_threads(fe["threads"], "fe.threads (--threads)")
