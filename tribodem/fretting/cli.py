@@ -27,7 +27,7 @@ from tribodem.contact import (
 )
 from tribodem.contact.fe.backend import PLASTIC_MIN_INCREMENTS
 from tribodem.contact.fe.backend3d import CONVERGED_SLOPE
-from tribodem.contact.fe.ccx import CcxNotFoundError
+from tribodem.contact.fe.ccx import CcxNotFoundError, CcxTimeoutError, FESolverStopped
 from tribodem.contact.geometry import (
     CrossedCylinders,
     CylinderOnFlat,
@@ -992,9 +992,8 @@ def run_fretting(cfg: FrettingConfig, out: Path, echo: Any = None, resume: bool 
     }
     summary = write_results(hist, out, extra)
     if hist.stopped:
-        fe_stop = isinstance(loop.solver, (FEContactSolver, BACKENDS["fe3d"])) and \
-            "window" not in hist.stopped
-        timed_out = fe_stop and "wall-clock limit" in hist.stopped
+        fe_stop = isinstance(loop.stop_error, FESolverStopped)
+        timed_out = isinstance(loop.stop_error, CcxTimeoutError)
         runs.announce(out, ck, resume_hint=(
                       f"raise fe.timeout (now {loop.solver.timeout:g} s) and add --resume to "
                       "the same command" if timed_out else

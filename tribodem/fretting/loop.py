@@ -196,6 +196,8 @@ class FrettingLoop:
         self._cycle = 0
         self._p_load = np.zeros((n, n))  # total pressure at the loading position, Pa
         self.history: FrettingHistory | None = None  #: set by the first loading
+        #: what stopped this session's run early (``history.stopped`` is its text)
+        self.stop_error: WindowTooSmallError | FESolverStopped | None = None
         self._done = 0  # cycles recorded (simulated + jumped)
         self._observe_pending = False  # last cycle of a finished run not shown to strategy
         self._last_per: dict[str, Any] = {}  # per-cycle values of the last simulated cycle
@@ -540,6 +542,7 @@ class FrettingLoop:
                 first = self.solver.solve_increment(0.0)  # normal loading at offset 0
             except (WindowTooSmallError, FESolverStopped) as err:
                 self.history.stopped = f"first loading: {err}"
+                self.stop_error = err
                 return self._finish(t0)
             self._p_load = first.pressure + self.solver.debris_pressure
             if self.strategy is not None:
@@ -548,6 +551,7 @@ class FrettingLoop:
         if cycles < self._done:
             raise ValueError(f"cycles = {cycles}: this run is already at cycle {self._done}")
         hist.stopped = None
+        self.stop_error = None
         c = self._done
         if self._observe_pending and c < cycles:  # a finished run extended
             self._observe_pending = False
@@ -558,6 +562,7 @@ class FrettingLoop:
                 per = self.simulate_cycle()
             except (WindowTooSmallError, FESolverStopped) as err:
                 hist.stopped = f"cycle {c + 1}: {err}"
+                self.stop_error = err
                 break
             c += 1
             hist.cycles_simulated += 1
