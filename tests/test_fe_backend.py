@@ -374,28 +374,33 @@ figures = false
 """
 
 
+def _ccx_wrapped_in_cycle_2(tmp_path: Path, action: str) -> dict[str, str]:
+    """The environment of a run whose ``ccx`` is a wrapper in front of Debian's: it runs the
+    shell ``action`` first when the job is cycle 2's (in its folder; ``$2`` is the job
+    name), then the real ccx (``TRIBODEM_CCX``: the wrapper, not a PARDISO build)."""
+    real = shutil.which("ccx")
+    assert real is not None
+    bin_dir = tmp_path / "bin"
+    bin_dir.mkdir()
+    wrapper = bin_dir / "ccx"
+    wrapper.write_text(f"#!/bin/sh\ncase \"$PWD\" in */cycle_0002) {action};; esac\n"
+                       f"exec {real} \"$@\"\n")
+    wrapper.chmod(wrapper.stat().st_mode | stat.S_IEXEC)
+    return dict(os.environ, PATH=f"{bin_dir}{os.pathsep}{os.environ['PATH']}",
+                TRIBODEM_CCX="ccx")
+
+
 @needs_ccx
 def test_ccx_failure_stops_the_run_with_exit_3(tmp_path: Path) -> None:
     """A deck ccx refuses (here: cycle 2's, spoiled by a wrapper in front of the real ccx)
     stops the run with exit 3, ccx's message and the deck path; cycle 1's outputs stay, and
     ``--resume`` (ccx fixed) finishes the run. (Resumed = uninterrupted, bitwise: measured
     on 2 cycles at h = a/2, results.csv identical.)"""
-    real = shutil.which("ccx")
-    assert real is not None
-    bin_dir = tmp_path / "bin"
-    bin_dir.mkdir()
-    wrapper = bin_dir / "ccx"
-    wrapper.write_text(
-        "#!/bin/sh\n"
-        "case \"$PWD\" in */cycle_0002) sed -i '2a *BOUNDARY\\nNOSUCHSET, 1, 2' \"$2.inp\";;"
-        " esac\n"
-        f"exec {real} \"$@\"\n")
-    wrapper.chmod(wrapper.stat().st_mode | stat.S_IEXEC)
+    env = _ccx_wrapped_in_cycle_2(
+        tmp_path, "sed -i '2a *BOUNDARY\\nNOSUCHSET, 1, 2' \"$2.inp\"")
     cfg = tmp_path / "fe.toml"
     cfg.write_text(CONFIG)
     out = tmp_path / "run"
-    env = dict(os.environ, PATH=f"{bin_dir}{os.pathsep}{os.environ['PATH']}",
-               TRIBODEM_CCX="ccx")  # the wrapper, not a PARDISO build
     r = run_tribodem("fretting", "run", "--config", str(cfg), "--out", str(out),
                      "--no-progress", env=env)
     assert r.returncode == 3, r.stderr
@@ -423,19 +428,10 @@ def test_a_ccx_job_over_its_time_limit_stops_with_the_setting_named(tmp_path: Pa
     """A job killed by ``fe.timeout`` (here cycle 2's, held up by a wrapper that sleeps
     first) stops the run with exit 3, the limit and the setting to raise; the resume with a
     larger limit (``fe.timeout`` may change on resume) finishes the run."""
-    real = shutil.which("ccx")
-    assert real is not None
-    bin_dir = tmp_path / "bin"
-    bin_dir.mkdir()
-    wrapper = bin_dir / "ccx"
-    wrapper.write_text("#!/bin/sh\ncase \"$PWD\" in */cycle_0002) sleep 120;; esac\n"
-                       f"exec {real} \"$@\"\n")
-    wrapper.chmod(wrapper.stat().st_mode | stat.S_IEXEC)
+    env = _ccx_wrapped_in_cycle_2(tmp_path, "sleep 120")
     cfg = tmp_path / "fe.toml"
     cfg.write_text(CONFIG.replace("[fe]\n", "[fe]\ntimeout = 30\n"))
     out = tmp_path / "run"
-    env = dict(os.environ, PATH=f"{bin_dir}{os.pathsep}{os.environ['PATH']}",
-               TRIBODEM_CCX="ccx")
     r = run_tribodem("fretting", "run", "--config", str(cfg), "--out", str(out),
                      "--no-progress", env=env)
     assert r.returncode == 3, r.stderr
