@@ -198,19 +198,45 @@ def test_fe3d_refuses_other_geometries(tmp_path: Path) -> None:
         _solver(tmp_path, mode="chained")
 
 
-def test_fe3d_mesh_fields_and_time_limit_from_the_config() -> None:
-    """[fe] h_over_a / size_factor at the 2D backend's defaults (0.25, 40): fe3d's own h =
-    a/3, bodies 8 a (a checkpoint's config records every field, so 0.25 set and left out
-    are one); other values are taken. The ccx time limit: the backend's own (4 h) unless
-    set."""
+def test_fe_mesh_fields_left_out_are_each_backends_own_and_set_are_taken() -> None:
+    """[fe] h_over_a / size_factor left out: each backend's own (fe3d h = a/3, bodies 8 a;
+    fe a/4, 40 a); set, they reach the backend as given, fe3d's 0.25 too (a/4; before
+    config_version 2 it was read as fe3d's own a/3). The ccx time limit: the backend's own
+    (4 h) unless set."""
     from tribodem.fretting.cli import FrettingConfig, build_solver
 
     own = build_solver(FrettingConfig.model_validate({"solver": "fe3d"}))
     assert (own.h_over_a, own.size_factor) == (pytest.approx(1 / 3), 8.0)
     set_ = build_solver(FrettingConfig.model_validate(
-        {"solver": "fe3d", "fe": {"h_over_a": 0.2499, "size_factor": 10.0, "timeout": 60}}))
-    assert (set_.h_over_a, set_.size_factor) == (0.2499, 10.0)
+        {"solver": "fe3d", "fe": {"h_over_a": 0.25, "size_factor": 10.0, "timeout": 60}}))
+    assert (set_.h_over_a, set_.size_factor) == (0.25, 10.0)
     assert (own.timeout, set_.timeout) == (14400.0, 60.0)
+    line = build_solver(FrettingConfig.model_validate(
+        {"solver": "fe", "contact": {"geometry": "cylinder_on_flat", "radius": 4e-3,
+                                     "load_per_length": 1e5}}))
+    assert (line.h_over_a, line.size_factor) == (0.25, 40.0)
+
+
+def test_an_old_default_fe3d_checkpoint_resumes_on_fe3ds_own_mesh() -> None:
+    """A checkpoint written before config_version 2 records [fe] h_over_a = 0.25 and
+    size_factor = 40.0 (every field was; fe3d ran its own a/3, 8 a on them): resumed as
+    ``fretting run --resume`` resumes it (its config as the base, checked against it), the
+    solver is built on a/3 and 8 a again."""
+    from tribodem.fretting.cli import (
+        FrettingConfig,
+        build_solver,
+        check_resume,
+        recorded_config,
+        resolve_config,
+    )
+
+    old = json.loads(json.dumps(FrettingConfig(solver="fe3d").model_dump()))
+    del old["config_version"]
+    old["fe"] |= {"h_over_a": 0.25, "size_factor": 40.0}
+    cfg = resolve_config(None, base=recorded_config(old))
+    check_resume(cfg, {"config": old, "cycles_done": 1}, Path("checkpoint.npz"))
+    solver = build_solver(cfg)
+    assert (solver.h_over_a, solver.size_factor) == (pytest.approx(1 / 3), 8.0)
 
 
 # --- one coarse ccx job: the loading and a gross-slip cycle -----------------------------------

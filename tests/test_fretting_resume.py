@@ -280,3 +280,109 @@ def test_resume_accepts_a_field_added_since_the_checkpoint_at_its_default_only()
     absent = r"fe\.plastic_increments = 16 \(checkpoint: '<absent>'\)"
     with pytest.raises(ConfigError, match=absent):
         check_resume(changed, meta, Path("ck.npz"))
+
+
+def _before_v2(cfg) -> dict:  # noqa: ANN001 - a FrettingConfig
+    """``cfg`` as tribodem recorded it before config_version 2: every field, [fe] h_over_a
+    and size_factor at the then defaults 0.25 / 40.0, no marker."""
+    old = json.loads(json.dumps(cfg.model_dump()))
+    del old["config_version"]
+    old["fe"] |= {"h_over_a": 0.25, "size_factor": 40.0}
+    return old
+
+
+def test_a_recorded_config_from_before_config_version_2_reads_the_old_defaults_as_left_out(
+) -> None:
+    """An unmarked recorded config's [fe] 0.25 / 40 (recorded for every run) are read as left
+    out: an old default fe3d checkpoint resumes with the fields left out (as a/3, 8 a) and
+    refuses 0.25 (a/4 is another run), naming the values fe3d gets; old fe and elastic
+    checkpoints resume with the fields left out or at 0.25 / 40. A marked config (this
+    version's) is read as it is: its fe3d 0.25 stays a/4."""
+    from tribodem.fretting.cli import (
+        CONFIG_VERSION,
+        FrettingConfig,
+        check_resume,
+        recorded_config,
+    )
+    from tribodem.io.config import ConfigError
+
+    ck = Path("checkpoint.npz")
+    fe3d = FrettingConfig(solver="fe3d")
+    old = _before_v2(fe3d)
+    read = recorded_config(old)
+    assert read["config_version"] == CONFIG_VERSION
+    assert (read["fe"]["h_over_a"], read["fe"]["size_factor"]) == (None, None)
+    assert resolve_config(None, base=read) == fe3d  # the resume without --config
+    check_resume(fe3d, {"config": old}, ck)
+    a4 = FrettingConfig(solver="fe3d", fe={"h_over_a": 0.25})
+    with pytest.raises(ConfigError, match=r"fe\.h_over_a = 0\.25 \(checkpoint: 0\.333"):
+        check_resume(a4, {"config": old}, ck)
+    marked = json.loads(json.dumps(a4.model_dump()))
+    assert recorded_config(marked) == marked
+    check_resume(a4, {"config": marked}, ck)
+    with pytest.raises(ConfigError, match=r"fe\.h_over_a = 0\.333.* \(checkpoint: 0\.25\)"):
+        check_resume(fe3d, {"config": marked}, ck)
+    line = {"contact": {"geometry": "cylinder_on_flat", "radius": 4e-3}}
+    for solver, extra in (("fe", line), ("elastic", {})):
+        left_out = FrettingConfig.model_validate({"solver": solver, **extra})
+        stated = FrettingConfig.model_validate(
+            {"solver": solver, **extra, "fe": {"h_over_a": 0.25, "size_factor": 40.0}})
+        for cfg in (left_out, stated):
+            check_resume(cfg, {"config": _before_v2(left_out)}, ck)
+
+
+def test_a_new_config_round_trips_with_its_marker(tmp_path: Path) -> None:
+    """What tribodem writes carries config_version: config.toml (the [fe] fields left out
+    stay out and reload as left out) and a checkpoint (read back unchanged, None stays
+    None, so a resume makes the same run)."""
+    from tribodem.fretting.cli import FrettingConfig, check_resume, recorded_config
+    from tribodem.fretting.output import read_checkpoint, write_checkpoint
+    from tribodem.io.config import dump_toml
+
+    cfg = FrettingConfig(solver="fe3d")
+    text = dump_toml(cfg.model_dump())
+    assert "config_version = 2" in text and "h_over_a" not in text
+    path = tmp_path / "config.toml"
+    path.write_text(text)
+    assert resolve_config(path) == cfg
+    write_checkpoint(tmp_path / "checkpoint.npz", {"config": json.loads(json.dumps(
+        cfg.model_dump())), "cycles_done": 1}, {})
+    meta, _ = read_checkpoint(tmp_path / "checkpoint.npz")
+    assert meta["config"]["config_version"] == 2 and meta["config"]["fe"]["h_over_a"] is None
+    assert resolve_config(None, base=recorded_config(meta["config"])) == cfg
+    check_resume(cfg, meta, tmp_path / "checkpoint.npz")
+
+
+def test_a_checkpoint_from_before_config_version_2_resumes(tmp_path: Path) -> None:
+    """A real run's checkpoint rewritten as before config_version 2 (no marker, [fe] 0.25 /
+    40) resumes: from its own config (``--resume`` alone) and from a config file that leaves
+    [fe] out; the resumed run records the marker and the fields left out. Old study.toml
+    files and a sweep member's old summary.json are read the same way."""
+    from tribodem.fretting.cli import _jsonable, recorded_config
+    from tribodem.fretting.debris_study import same_study
+    from tribodem.fretting.output import CHECKPOINT, read_checkpoint, write_checkpoint
+    from tribodem.fretting.sweep import member_plan
+    from tribodem.io.config import dump_toml
+
+    cfg = resolve_config(None, quick=True, overrides={
+        "cycles": 2, "output": {"figures": False, "vtk": False}})
+    out = tmp_path / "run"
+    run_fretting(cfg, out)
+    meta, state = read_checkpoint(out / CHECKPOINT)
+    old = _before_v2(cfg)
+    write_checkpoint(out / CHECKPOINT, {**meta, "config": old}, state)
+    more = resolve_config(None, overrides={"cycles": 3}, base=recorded_config(old))
+    assert more == cfg.model_copy(update={"cycles": 3})
+    run_fretting(more, out, resume=True)
+    meta, state = read_checkpoint(out / CHECKPOINT)
+    assert meta["cycles_done"] == 3 and meta["config"] == _jsonable(more)
+    write_checkpoint(out / CHECKPOINT, {**meta, "config": _before_v2(more)}, state)
+    run_fretting(more.model_copy(update={"cycles": 4}), out, resume=True)  # --config FILE
+    assert read_checkpoint(out / CHECKPOINT)[0]["cycles_done"] == 4
+    # a study's study.toml and a sweep member's summary.json of before
+    (tmp_path / "study.toml").write_text(dump_toml({"config": old, "quick": True}))
+    assert same_study(tmp_path, {"config": _jsonable(cfg), "quick": True})
+    member = tmp_path / "member"
+    member.mkdir()
+    (member / "summary.json").write_text(json.dumps({"config": old, "cycles": 2}))
+    assert member_plan(_jsonable(cfg), member)[0] == "done"

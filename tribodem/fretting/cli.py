@@ -318,12 +318,13 @@ class FEConfig(_Model):
     plastic_increments: int = Field(
         PLASTIC_MIN_INCREMENTS, ge=4, le=10000, description="elastic-plastic: the fewest ccx "
         "increments per cycle (32 converged where 16 stalled, docs/fe.md)")
-    h_over_a: float = Field(0.25, gt=0, le=1, description="element size at the contact / "
-                            "Hertz half-width (docs/fe.md: a/4 is 4x faster than a/8 at "
-                            "large strokes; fe3d: at 0.25, its own 1/3; a/4 is 0.2499)")
-    size_factor: float = Field(40.0, ge=2, le=200, description="bodies' size / contact "
-                               "half-width or radius (fe: >= 10; fe3d: its default 8, at "
-                               "most R / (2 a))")
+    h_over_a: float | None = Field(
+        None, gt=0, le=1, description="element size at the contact / Hertz half-width or "
+        "radius (left out: the backend's own, fe 0.25, fe3d 1/3; docs/fe.md: a/4 is 4x "
+        "faster than a/8 at large strokes)")
+    size_factor: float | None = Field(
+        None, ge=2, le=200, description="bodies' size / contact half-width or radius (left "
+        "out: the backend's own, fe 40, fe3d 8; fe: >= 10; fe3d: at most R / (2 a))")
     threads: int = Field(1, ge=0, description="ccx threads (0 = all cores; --threads)")
     timeout: float | None = Field(
         None, gt=0, description="wall-clock limit of one ccx job, s (left out: the "
@@ -352,11 +353,22 @@ class FEConfig(_Model):
         return float(v)
 
 
+#: Layout version of the fretting config, recorded as ``config_version`` in every config
+#: tribodem writes (config.toml, summary.json, checkpoint.npz, study.toml). 2: ``[fe]
+#: h_over_a`` / ``size_factor`` left out are the backend's own (:data:`FE_BACKEND_OWN`); a
+#: recorded config without it is older (:func:`recorded_config`).
+CONFIG_VERSION = 2
+
+
 class FrettingConfig(_Model):
     """``tribodem fretting run`` configuration (TOML tables contact, wear, jump, output)."""
 
     cycles: int = Field(160, ge=1, le=10**7)
     solver: str = Field("elastic", description="first-body backend (tribodem.contact.BACKENDS)")
+    config_version: int = Field(
+        CONFIG_VERSION, ge=CONFIG_VERSION, le=CONFIG_VERSION, description="the config "
+        "layout, written by tribodem into the configs it records; leave it out of your own "
+        "files (they are read as this version)")
     contact: ContactConfig = Field(default_factory=ContactConfig)
     wear: WearConfig = Field(default_factory=WearConfig)
     jump: JumpConfig = Field(default_factory=JumpConfig)
@@ -742,6 +754,11 @@ def check_compatible(cfg: FrettingConfig) -> None:
                 f"{' or '.join(allowed) or '(no solver registered)'}")
 
 
+#: ``[fe]`` fields whose None (left out) is the backend's own default, which differs
+#: between fe and fe3d: not passed on
+FE_BACKEND_OWN = ("h_over_a", "size_factor", "timeout")
+
+
 def build_solver(cfg: FrettingConfig) -> FirstBodySolver:
     """The configured first-body backend (:data:`tribodem.contact.BACKENDS`) on the case."""
     c = cfg.contact
@@ -760,15 +777,8 @@ def build_solver(cfg: FrettingConfig) -> FirstBodySolver:
     if "line" in backend.capabilities.contacts and not isinstance(geo, HeightMaps):
         kw["contact"] = geo.contact
     if backend in (FEContactSolver, BACKENDS["fe3d"]):
-        fe = cfg.fe.model_dump()
-        if backend is not FEContactSolver:  # fe3d: the [fe] mesh fields at their 2D
-            # defaults (h = a/4, bodies 40 a) do not fit the 3D model: its own apply (h =
-            # a/3, bodies 8 a). A checkpoint's config records every field, so "set to 0.25"
-            # and "left out" cannot be told apart there: a/4 is asked for as 0.2499
-            fe = {k: v for k, v in fe.items() if k not in ("h_over_a", "size_factor")
-                  or v != type(cfg.fe).model_fields[k].default}
-        if fe["timeout"] is None:  # the backend's own limit
-            del fe["timeout"]
+        fe = {k: v for k, v in cfg.fe.model_dump().items()
+              if v is not None or k not in FE_BACKEND_OWN}
         fe["threads"] = runs.check_threads(fe["threads"], "fe.threads (--threads)")
         takes = inspect.signature(backend).parameters
         for k in [k for k in fe if k not in takes]:  # an [fe] field this backend lacks
@@ -871,6 +881,47 @@ def _jsonable(cfg: FrettingConfig) -> dict[str, Any]:
     return json.loads(json.dumps(cfg.model_dump()))
 
 
+#: ``[fe]`` defaults that tribodem recorded in every config before ``config_version`` 2 (it
+#: dumped every field): there they meant "left out", and fe3d ran its own mesh on them
+FE_DEFAULTS_BEFORE_V2: dict[str, float] = {"h_over_a": 0.25, "size_factor": 40.0}
+
+
+def recorded_config(data: dict[str, Any]) -> dict[str, Any]:
+    """A config that tribodem recorded (a checkpoint's, study.toml's, a run folder's
+    summary.json or config.toml) as this version reads it; a user's config file is never
+    read through this: it means what it says.
+
+    Without ``config_version`` it was written before version 2, when every config held
+    ``[fe] h_over_a = 0.25`` and ``size_factor = 40.0`` unless they were set otherwise and
+    fe3d read these values as "its own" (h = a/3, bodies 8 a): they become None, left out,
+    the backend's own (for fe the same 0.25 and 40), and the version is added.
+    """
+    if "config_version" in data:
+        return data
+    fe = data.get("fe")
+    if isinstance(fe, dict):
+        old = FE_DEFAULTS_BEFORE_V2
+        data = {**data, "fe": {k: None if k in old and v == old[k] else v
+                               for k, v in fe.items()}}
+    return {**data, "config_version": CONFIG_VERSION}
+
+
+def effective_config(data: dict[str, Any]) -> dict[str, Any]:
+    """``data`` (a config as a dict) with its ``[fe]`` fields of :data:`FE_BACKEND_OWN` as
+    its solver's backend takes them: left out (None or absent), the backend's own default
+    (fe3d: h_over_a 1/3, size_factor 8); for a solver without ccx, none (they do nothing
+    there). For telling whether two configs make the same run."""
+    fe = data.get("fe")
+    if not isinstance(fe, dict):
+        return data
+    backend = BACKENDS.get(str(data.get("solver")))
+    out = {k: v for k, v in fe.items() if k not in FE_BACKEND_OWN}
+    if backend in (FEContactSolver, BACKENDS["fe3d"]):
+        takes = inspect.signature(backend).parameters
+        out |= {k: takes[k].default if fe.get(k) is None else fe[k] for k in FE_BACKEND_OWN}
+    return {**data, "fe": out}
+
+
 #: Config fields a resumed run may change: ``cycles`` (raised, to extend a run), the
 #: ``[output]`` table (what is written, not the numbers), how ccx runs (threads, time limit,
 #: job cache) and, to go on from a stopped finite-element cycle, its retries and the worn
@@ -882,9 +933,11 @@ RESUME_MAY_CHANGE = ("cycles", "output.", "fe.threads", "fe.timeout", "fe.cache"
 
 def check_resume(cfg: FrettingConfig, meta: dict[str, Any], path: Path) -> None:
     """Refuse (``ConfigError``) resuming checkpoint ``path`` with a different config (every
-    differing field named with both values) or fewer cycles than it already has."""
-    old = _flat(meta.get("config") or {})
-    new = _flat(_jsonable(cfg))
+    differing field named with both values) or fewer cycles than it already has. The
+    checkpoint's config is read as :func:`recorded_config` reads it, both compared as
+    :func:`effective_config` gives them."""
+    old = _flat(effective_config(recorded_config(meta.get("config") or {})))
+    new = _flat(effective_config(_jsonable(cfg)))
     absent = "<absent>"
     # A field added to tribodem after the checkpoint was made is absent from it; at its
     # default it keeps the behaviour the checkpoint ran with, so it is not a difference.
@@ -1068,7 +1121,8 @@ def run_cmd(
     runs.check_out_dir(out, "--out", resume=resume, need=(CHECKPOINT,) if resume else ())
     ck = read_checkpoint(out / CHECKPOINT) if resume else None
     cfg = resolve_config(config, quick=quick, overrides=ov,
-                         base=ck[0].get("config") if ck is not None else None)
+                         base=recorded_config(ck[0].get("config") or {})
+                         if ck is not None else None)
     summary = run_fretting(cfg, out, echo=typer.echo, resume=resume, progress=progress,
                            checkpoint=ck)
     typer.echo(
@@ -1114,6 +1168,7 @@ def study_cmd(
     """Seed 003 chapter 6: every material evolution criterion on one case (one cycle for
     von Mises, S22, DFDI, SWT; 30 for shear and energy; shear with jumping to 110), the
     seed's numbers beside ours and the criteria ordered (study.md, study.json)."""
+    from tribodem.fretting.debris_study import read_study
     from tribodem.fretting.study import run_study
 
     runs.check_out_dir(out, "--out", resume=resume, need=("study.toml",) if resume else ())
@@ -1122,8 +1177,7 @@ def study_cmd(
         ov["solver"] = solver
     if threads is not None:
         ov.setdefault("fe", {})["threads"] = threads
-    base = load_toml(out / "study.toml", "--out")["config"] if resume and config is None \
-        else None
+    base = read_study(out)["config"] if resume and config is None else None
     cfg = resolve_config(config, quick=quick, overrides=ov, base=base)
     only = None if stages is None else tuple(x.strip() for x in stages.split(","))
     summary = run_study(cfg, out, quick=quick, resume=resume, progress=progress,
@@ -1155,12 +1209,12 @@ def debris_study_cmd(
     debris particles (figs 5.22-5.27); writes debris_study.{csv,json}, plots, per-count data."""
     import numba
 
-    from tribodem.fretting.debris_study import SEED_COUNTS, run_debris_study
+    from tribodem.fretting.debris_study import SEED_COUNTS, read_study, run_debris_study
 
     n_threads = runs.check_threads(threads, "--threads")
     runs.check_out_dir(out, "--out", resume=resume, need=("study.toml",) if resume else ())
     # a resume takes the study's own config and counts unless they are given again
-    study = load_toml(out / "study.toml", "--out") if resume else {}
+    study = read_study(out) if resume else {}
     default = ",".join(str(c) for c in study["counts"]) if resume else \
         QUICK_STUDY_COUNTS if quick else ",".join(str(c) for c in SEED_COUNTS)
     wanted = parse_counts(counts if counts is not None else default)

@@ -327,7 +327,7 @@ def run_debris_study(cfg: Any, out: Path, counts: tuple[int, ...] = SEED_COUNTS,
     from tribodem.fretting.cli import _jsonable, build_loop, debris_settings, run_fretting
     from tribodem.fretting.output import CHECKPOINT, read_checkpoint
     from tribodem.io import runs
-    from tribodem.io.config import ConfigError, dump_toml, load_toml
+    from tribodem.io.config import ConfigError, dump_toml
     from tribodem.io.results import write_text
 
     say = echo or (lambda s: None)
@@ -344,7 +344,7 @@ def run_debris_study(cfg: Any, out: Path, counts: tuple[int, ...] = SEED_COUNTS,
     meta = {"config": _jsonable(cfg), "counts": [int(c) for c in counts]}
     if resume:
         old = out / "study.toml"
-        if load_toml(old) != load_toml_roundtrip(meta):
+        if not same_study(out, meta):
             raise ConfigError(f"--resume: the config or counts differ from the study in "
                               f"'{out}' ({old}); allowed: the same config and --counts")
     else:
@@ -419,3 +419,28 @@ def load_toml_roundtrip(data: dict[str, Any]) -> dict[str, Any]:
     from tribodem.io.config import dump_toml
 
     return tomllib.loads(dump_toml(data))
+
+
+def read_study(out: Path) -> dict[str, Any]:
+    """``out/study.toml`` of an earlier study (``fretting study``, ``debris-study``) as
+    :func:`load_toml_roundtrip` gives it, its config read as
+    :func:`~tribodem.fretting.cli.recorded_config` reads a recorded one (``ConfigError``
+    naming ``--out`` when it cannot be read)."""
+    from tribodem.fretting.cli import recorded_config
+    from tribodem.io.config import load_toml
+
+    data = load_toml(Path(out) / "study.toml", "--out")
+    if isinstance(data.get("config"), dict):
+        data["config"] = recorded_config(data["config"])
+    return load_toml_roundtrip(data)
+
+
+def same_study(out: Path, meta: dict[str, Any]) -> bool:
+    """Whether ``out/study.toml`` (:func:`read_study`) records the study ``meta`` (its
+    ``config`` and the rest), the configs compared as
+    :func:`~tribodem.fretting.cli.effective_config` gives them."""
+    from tribodem.fretting.cli import effective_config
+
+    def view(study: dict[str, Any]) -> dict[str, Any]:
+        return {**study, "config": effective_config(study.get("config") or {})}
+    return view(read_study(out)) == view(load_toml_roundtrip(meta))

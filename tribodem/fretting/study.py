@@ -245,7 +245,7 @@ def run_study(cfg: Any, out: Path, quick: bool = False, resume: bool = False,
     from tribodem.fretting.cli import _jsonable, check_compatible, run_fretting
     from tribodem.fretting.output import CHECKPOINT
     from tribodem.io import runs
-    from tribodem.io.config import ConfigError, dump_toml, load_toml
+    from tribodem.io.config import ConfigError, dump_toml
     from tribodem.io.results import write_json, write_text
 
     say = echo or (lambda s: None)
@@ -257,9 +257,9 @@ def run_study(cfg: Any, out: Path, quick: bool = False, resume: bool = False,
         raise ConfigError(str(err)) from None
     meta = {"config": _jsonable(cfg), "quick": bool(quick)}
     if resume:
-        from tribodem.fretting.debris_study import load_toml_roundtrip
+        from tribodem.fretting.debris_study import same_study
 
-        if load_toml(out / "study.toml") != load_toml_roundtrip(meta):
+        if not same_study(out, meta):
             raise ConfigError(f"--resume: the config differs from the study in '{out}'; "
                               "allowed: the same config (and --quick) as the study")
     out.mkdir(parents=True, exist_ok=True)

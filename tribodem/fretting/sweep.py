@@ -51,6 +51,8 @@ from tribodem.fretting.cli import (
     check_resume,
     check_window,
     debris_settings,
+    effective_config,
+    recorded_config,
     run_fretting,
 )
 from tribodem.fretting.output import CHECKPOINT, read_checkpoint
@@ -295,11 +297,15 @@ def member_plan(cfg_data: dict[str, Any], d: Path) -> tuple[str, Any]:
     """What a member needs: ("done", summary) when ``d`` holds its finished run with the
     same config, ("stopped", summary) when it holds its run stopped early with the same
     config, ("resume", None) when it holds a checkpoint this config may resume, else
-    ("new", why-not-reused or None)."""
+    ("new", why-not-reused or None). The folder's configs are read as
+    :func:`~tribodem.fretting.cli.recorded_config` reads them and compared as
+    :func:`~tribodem.fretting.cli.effective_config` gives them."""
     cfg = validate(FrettingConfig, cfg_data, source=f"member '{d}'")
-    new = _jsonable(cfg)
+    new = effective_config(_jsonable(cfg))
     s = _summary(d)
-    if s is not None and s.get("config") == new:
+    old = (s or {}).get("config")
+    old = effective_config(recorded_config(old)) if isinstance(old, dict) else None
+    if s is not None and old == new:
         if s.get("stopped"):
             return "stopped", s
         if s.get("cycles") == cfg.cycles:
@@ -312,10 +318,9 @@ def member_plan(cfg_data: dict[str, Any], d: Path) -> tuple[str, Any]:
             return "resume", None
         except ConfigError:
             pass
-    old = (s or {}).get("config")
     if old is None and (d / "config.toml").is_file():
         try:
-            old = load_toml(d / "config.toml")
+            old = effective_config(recorded_config(load_toml(d / "config.toml")))
         except ConfigError:
             return "new", "its config.toml cannot be read"
     if old is None:
