@@ -359,7 +359,7 @@ def test_a_checkpoint_from_before_config_version_2_resumes(tmp_path: Path) -> No
     [fe] out; the resumed run records the marker and the fields left out. Old study.toml
     files and a sweep member's old summary.json are read the same way."""
     from tribodem.fretting.cli import _jsonable, recorded_config
-    from tribodem.fretting.debris_study import same_study
+    from tribodem.fretting.debris_study import study_diffs
     from tribodem.fretting.output import CHECKPOINT, read_checkpoint, write_checkpoint
     from tribodem.fretting.sweep import member_plan
     from tribodem.io.config import dump_toml
@@ -381,8 +381,30 @@ def test_a_checkpoint_from_before_config_version_2_resumes(tmp_path: Path) -> No
     assert read_checkpoint(out / CHECKPOINT)[0]["cycles_done"] == 4
     # a study's study.toml and a sweep member's summary.json of before
     (tmp_path / "study.toml").write_text(dump_toml({"config": old, "quick": True}))
-    assert same_study(tmp_path, {"config": _jsonable(cfg), "quick": True})
+    assert study_diffs(tmp_path, {"config": _jsonable(cfg), "quick": True}) == []
     member = tmp_path / "member"
     member.mkdir()
     (member / "summary.json").write_text(json.dumps({"config": old, "cycles": 2}))
     assert member_plan(_jsonable(cfg), member)[0] == "done"
+
+
+def test_a_study_resumes_with_other_threads_or_retries_and_names_what_may_not_change(
+        tmp_path: Path) -> None:
+    """A study (``fretting study``, ``debris-study``) resumes under the rule of a run's
+    resume: how ccx runs (``fe.threads`` / ``retries`` / ``timeout``) may change (a long
+    fe3d study goes on on another machine, or with more retries after a non-convergence);
+    a field that makes another run is refused by name with both values, and so is
+    ``--quick``."""
+    from tribodem.fretting.cli import _jsonable
+    from tribodem.fretting.debris_study import study_diffs
+    from tribodem.io.config import dump_toml
+
+    cfg = resolve_config(None, overrides={"solver": "fe3d", "fe": {"threads": 2}})
+    (tmp_path / "study.toml").write_text(dump_toml({"config": _jsonable(cfg), "quick": False}))
+    other = cfg.model_copy(update={"fe": cfg.fe.model_copy(
+        update={"threads": 1, "retries": 4, "timeout": 7200.0})})
+    assert study_diffs(tmp_path, {"config": _jsonable(other), "quick": False}) == []
+    rougher = cfg.model_copy(update={"contact": cfg.contact.model_copy(
+        update={"friction": 0.7})})
+    assert study_diffs(tmp_path, {"config": _jsonable(rougher), "quick": True}) == [
+        f"contact.friction = 0.7 (study: {cfg.contact.friction!r})", "quick = True (study: False)"]

@@ -931,27 +931,38 @@ RESUME_MAY_CHANGE = ("cycles", "output.", "fe.threads", "fe.timeout", "fe.cache"
                      "fe.retries", "fe.max_wear_slope")
 
 
+def resume_diffs(old_cfg: dict[str, Any], new_cfg: dict[str, Any],
+                 what: str = "checkpoint") -> list[str]:
+    """The fields in which config ``new_cfg`` would make another run than the recorded
+    config ``old_cfg`` (read as :func:`recorded_config` reads it), each as "field = new
+    (``what``: old)": both compared as :func:`effective_config` gives them, without the
+    fields a resume may change (:data:`RESUME_MAY_CHANGE`) and without a field added to
+    tribodem after the record was made that ``new_cfg`` leaves at its default (it keeps the
+    behaviour the record ran with)."""
+    old = _flat(effective_config(recorded_config(old_cfg)))
+    new = _flat(effective_config(new_cfg))
+    absent = "<absent>"
+    default = _flat(_jsonable(FrettingConfig()))
+    return [f"{k} = {new.get(k, absent)!r} ({what}: {old.get(k, absent)!r})"
+            for k in sorted(set(old) | set(new))
+            if not k.startswith(RESUME_MAY_CHANGE) and old.get(k, absent) != new.get(k, absent)
+            and not (k not in old and k in default and new.get(k) == default[k])]
+
+
+#: what a refused resume says may change
+RESUME_ALLOWED = ("only cycles, to extend the run, the [output] table and fe.threads / "
+                  "timeout / cache / retries / max_wear_slope may change")
+
+
 def check_resume(cfg: FrettingConfig, meta: dict[str, Any], path: Path) -> None:
     """Refuse (``ConfigError``) resuming checkpoint ``path`` with a different config (every
-    differing field named with both values) or fewer cycles than it already has. The
-    checkpoint's config is read as :func:`recorded_config` reads it, both compared as
-    :func:`effective_config` gives them."""
-    old = _flat(effective_config(recorded_config(meta.get("config") or {})))
-    new = _flat(effective_config(_jsonable(cfg)))
-    absent = "<absent>"
-    # A field added to tribodem after the checkpoint was made is absent from it; at its
-    # default it keeps the behaviour the checkpoint ran with, so it is not a difference.
-    default = _flat(_jsonable(FrettingConfig()))
-    diffs = [f"{k} = {new.get(k, absent)!r} (checkpoint: {old.get(k, absent)!r})"
-             for k in sorted(set(old) | set(new))
-             if not k.startswith(RESUME_MAY_CHANGE) and old.get(k, absent) != new.get(k, absent)
-             and not (k not in old and k in default and new.get(k) == default[k])]
+    differing field named with both values, :func:`resume_diffs`) or fewer cycles than it
+    already has."""
+    diffs = resume_diffs(meta.get("config") or {}, _jsonable(cfg))
     if diffs:
         raise ConfigError(
             f"--resume: the config differs from the one checkpoint '{path}' was made with: "
-            + "; ".join(diffs) + "; allowed: the checkpoint's values (only cycles, to extend "
-            "the run, the [output] table and fe.threads / timeout / cache / retries / "
-            "max_wear_slope may change)")
+            + "; ".join(diffs) + f"; allowed: the checkpoint's values ({RESUME_ALLOWED})")
     done = int(meta.get("cycles_done", 0))
     if cfg.cycles < done:
         raise ConfigError(f"cycles = {cfg.cycles}: checkpoint '{path}' is already at cycle "

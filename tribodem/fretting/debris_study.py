@@ -324,7 +324,13 @@ def run_debris_study(cfg: Any, out: Path, counts: tuple[int, ...] = SEED_COUNTS,
     with its checkpoint), ``count_NNNNNN.{npz,json}`` per count; ``resume`` skips finished
     stages and resumes the wear run from its checkpoint.
     """
-    from tribodem.fretting.cli import _jsonable, build_loop, debris_settings, run_fretting
+    from tribodem.fretting.cli import (
+        RESUME_ALLOWED,
+        _jsonable,
+        build_loop,
+        debris_settings,
+        run_fretting,
+    )
     from tribodem.fretting.output import CHECKPOINT, read_checkpoint
     from tribodem.io import runs
     from tribodem.io.config import ConfigError, dump_toml
@@ -344,9 +350,11 @@ def run_debris_study(cfg: Any, out: Path, counts: tuple[int, ...] = SEED_COUNTS,
     meta = {"config": _jsonable(cfg), "counts": [int(c) for c in counts]}
     if resume:
         old = out / "study.toml"
-        if not same_study(out, meta):
+        diffs = study_diffs(out, meta)
+        if diffs:
             raise ConfigError(f"--resume: the config or counts differ from the study in "
-                              f"'{out}' ({old}); allowed: the same config and --counts")
+                              f"'{out}' ({old}): {'; '.join(diffs)}; allowed: the same "
+                              f"config and --counts ({RESUME_ALLOWED})")
     else:
         for stale in [*out.glob("count_*.json"), *out.glob("count_*.npz")]:
             stale.unlink()
@@ -435,12 +443,17 @@ def read_study(out: Path) -> dict[str, Any]:
     return load_toml_roundtrip(data)
 
 
-def same_study(out: Path, meta: dict[str, Any]) -> bool:
-    """Whether ``out/study.toml`` (:func:`read_study`) records the study ``meta`` (its
-    ``config`` and the rest), the configs compared as
-    :func:`~tribodem.fretting.cli.effective_config` gives them."""
-    from tribodem.fretting.cli import effective_config
+def study_diffs(out: Path, meta: dict[str, Any]) -> list[str]:
+    """What keeps the study ``meta`` (its ``config`` and the rest: ``quick``, ``counts``)
+    from resuming the one ``out/study.toml`` records (:func:`read_study`), each as "field =
+    new (study: old)": the configs compared as a run's resume compares them
+    (:func:`~tribodem.fretting.cli.resume_diffs`: how ccx runs, ``[output]`` and ``cycles``
+    may change), the rest by equality. Empty when it may resume."""
+    from tribodem.fretting.cli import resume_diffs
 
-    def view(study: dict[str, Any]) -> dict[str, Any]:
-        return {**study, "config": effective_config(study.get("config") or {})}
-    return view(read_study(out)) == view(load_toml_roundtrip(meta))
+    old = read_study(out)
+    new = load_toml_roundtrip(meta)
+    diffs = resume_diffs(old.get("config") or {}, new.get("config") or {}, what="study")
+    return diffs + [f"{k} = {new.get(k)!r} (study: {old.get(k)!r})"
+                    for k in sorted((set(old) | set(new)) - {"config"})
+                    if old.get(k) != new.get(k)]
