@@ -111,6 +111,34 @@ def test_ctrl_c_exits_130_naming_outputs_then_resume_equals(small_cfg: Path, ref
     _same_outputs(reference, out)
 
 
+def test_a_run_carried_to_another_folder_resumes_to_the_same_result(
+        small_cfg: Path, reference: Path, tmp_path: Path) -> None:
+    """``tools/carry_run pack`` takes what ``--resume`` needs of a killed run, and nothing
+    else the run depends on: unpacked into another folder (as on another machine), the run
+    goes on there to the uninterrupted run's results, bitwise."""
+    root = Path(__file__).resolve().parents[1]
+    out = tmp_path / "here" / "run"
+    r = _start_and_signal(_args(small_cfg, out), out, signal.SIGKILL)
+    assert r.returncode in (-signal.SIGKILL, 0)
+    archive = tmp_path / "run.tar.gz"
+    carry = ["bash", str(root / "tools" / "carry_run")]
+    r = subprocess.run([*carry, "pack", str(out), str(archive)], capture_output=True,
+                       text=True, timeout=60)
+    assert r.returncode == 0, r.stderr
+    r = subprocess.run([*carry, "unpack", str(archive), str(tmp_path / "there")],
+                       capture_output=True, text=True, timeout=60)
+    assert r.returncode == 0, r.stderr
+    moved = tmp_path / "there" / "run"
+    assert {p.name for p in moved.iterdir()} <= {
+        "checkpoint.npz", "config.toml", "results.csv", "criterion.csv", "summary.json"}
+    r = run_tribodem(*_args(small_cfg, moved, "--resume"), timeout=120)
+    assert r.returncode == 0, r.stderr
+    _same_outputs(reference, moved)
+    r = subprocess.run([*carry, "pack", str(tmp_path / "nowhere"), str(archive)],
+                       capture_output=True, text=True, timeout=60)
+    assert r.returncode == 2 and "nowhere" in r.stderr, r.stderr
+
+
 def _in_process(tmp: Path, monkeypatch: pytest.MonkeyPatch, name: str, cycles: int,
                 extra: dict, stop_after: int) -> None:
     """Uninterrupted vs interrupted (Ctrl-C raised right after the ``stop_after``-th
