@@ -68,3 +68,12 @@ seed = 3
 #: their anchored layers and one impact can take one, so the worn-through guard (which
 #: would stop the run, exit 3) is off in these mechanics tests; test_braking tests it
 TINY_RUN = "worn_through_diameters = 0.0\n"
+
+
+def before_config_v2(cfg) -> dict:  # noqa: ANN001 - a FrettingConfig
+    """``cfg`` as tribodem recorded it before config_version 2: every field, [fe] h_over_a
+    and size_factor at the then defaults 0.25 / 40.0, no marker."""
+    old = cfg.model_dump(mode="json")
+    del old["config_version"]
+    old["fe"] |= {"h_over_a": 0.25, "size_factor": 40.0}
+    return old

@@ -222,6 +222,8 @@ def test_an_old_default_fe3d_checkpoint_resumes_on_fe3ds_own_mesh() -> None:
     size_factor = 40.0 (every field was; fe3d ran its own a/3, 8 a on them): resumed as
     ``fretting run --resume`` resumes it (its config as the base, checked against it), the
     solver is built on a/3 and 8 a again."""
+    from conftest import before_config_v2
+
     from tribodem.fretting.cli import (
         FrettingConfig,
         build_solver,
@@ -230,9 +232,7 @@ def test_an_old_default_fe3d_checkpoint_resumes_on_fe3ds_own_mesh() -> None:
         resolve_config,
     )
 
-    old = json.loads(json.dumps(FrettingConfig(solver="fe3d").model_dump()))
-    del old["config_version"]
-    old["fe"] |= {"h_over_a": 0.25, "size_factor": 40.0}
+    old = before_config_v2(FrettingConfig(solver="fe3d"))
     cfg = resolve_config(None, base=recorded_config(old))
     check_resume(cfg, {"config": old, "cycles_done": 1}, Path("checkpoint.npz"))
     solver = build_solver(cfg)

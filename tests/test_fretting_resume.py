@@ -18,6 +18,7 @@ import time
 from pathlib import Path
 
 import pytest
+from conftest import before_config_v2 as _before_v2
 from conftest import run_tribodem, tribodem_exe
 
 from tribodem.fretting.cli import resolve_config, run_fretting
@@ -310,15 +311,6 @@ def test_resume_accepts_a_field_added_since_the_checkpoint_at_its_default_only()
         check_resume(changed, meta, Path("ck.npz"))
 
 
-def _before_v2(cfg) -> dict:  # noqa: ANN001 - a FrettingConfig
-    """``cfg`` as tribodem recorded it before config_version 2: every field, [fe] h_over_a
-    and size_factor at the then defaults 0.25 / 40.0, no marker."""
-    old = json.loads(json.dumps(cfg.model_dump()))
-    del old["config_version"]
-    old["fe"] |= {"h_over_a": 0.25, "size_factor": 40.0}
-    return old
-
-
 def test_a_recorded_config_from_before_config_version_2_reads_the_old_defaults_as_left_out(
 ) -> None:
     """An unmarked recorded config's [fe] 0.25 / 40 (recorded for every run) are read as left
@@ -436,3 +428,25 @@ def test_a_study_resumes_with_other_threads_or_retries_and_names_what_may_not_ch
         update={"friction": 0.7})})
     assert study_diffs(tmp_path, {"config": _jsonable(rougher), "quick": True}) == [
         f"contact.friction = 0.7 (study: {cfg.contact.friction!r})", "quick = True (study: False)"]
+    # a debris study's cycle is its phases' cycle: there, cycles may not change
+    later = _jsonable(cfg.model_copy(update={"cycles": 40}))
+    assert study_diffs(tmp_path, {"config": later, "quick": False}) == []
+    assert study_diffs(tmp_path, {"config": later, "quick": False}, may_change=("fe.",)) == [
+        f"cycles = 40 (study: {cfg.cycles!r})"]
+
+
+def test_a_recorded_config_reloads_to_the_same_config(tmp_path: Path) -> None:
+    """What tribodem records of a config (``config.toml``, study.toml: TOML, which has no
+    null) reloads to the same config, field for field: a field left out (None) whose
+    default is not None, such as ``[fe] max_wear_slope = "off"`` (default 0.1), is recorded
+    in a form that reloads as itself."""
+    from tribodem.fretting.cli import FrettingConfig, _jsonable, recorded_config
+    from tribodem.io.config import dump_toml, load_toml
+
+    cfg = resolve_config(None, overrides={"solver": "fe3d", "fe": {
+        "max_wear_slope": "off", "h_over_a": 0.25, "timeout": 60.0}})
+    assert cfg.fe.max_wear_slope is None and cfg.fe.size_factor is None
+    path = tmp_path / "config.toml"
+    path.write_text(dump_toml(_jsonable(cfg)))
+    assert FrettingConfig.model_validate(recorded_config(load_toml(path))) == cfg
+    assert resolve_config(None, base=recorded_config(load_toml(path))) == cfg

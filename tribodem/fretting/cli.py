@@ -6,7 +6,6 @@ Python API: :func:`run_fretting` (config -> files in ``out``, returns the summar
 from __future__ import annotations
 
 import inspect
-import json
 import math
 import time
 from pathlib import Path
@@ -14,7 +13,15 @@ from typing import Annotated, Any, Literal
 
 import numpy as np
 import typer
-from pydantic import BaseModel, ConfigDict, Field, ValidationInfo, field_validator, model_validator
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    ValidationInfo,
+    field_serializer,
+    field_validator,
+    model_validator,
+)
 
 from tribodem import __version__
 from tribodem.contact import (
@@ -351,6 +358,12 @@ class FEConfig(_Model):
         if isinstance(v, bool) or not isinstance(v, int | float) or not 0 < v <= 10:
             raise ValueError("allowed: a number > 0 and <= 10 (a slope), or 'off'")
         return float(v)
+
+    @field_serializer("max_wear_slope", when_used="json")
+    def _off(self, v: float | None) -> float | str:
+        """Recorded as 'off', not None: a TOML file has no null, and a field left out there
+        reloads as the default slope, not as off."""
+        return "off" if v is None else v
 
 
 #: Layout version of the fretting config, recorded as ``config_version`` in every config
@@ -759,6 +772,11 @@ def check_compatible(cfg: FrettingConfig) -> None:
 FE_BACKEND_OWN = ("h_over_a", "size_factor", "timeout")
 
 
+def ccx_backends() -> tuple[type, ...]:
+    """The first-body backends that run CalculiX and take the ``[fe]`` table."""
+    return (FEContactSolver, BACKENDS["fe3d"])
+
+
 def build_solver(cfg: FrettingConfig) -> FirstBodySolver:
     """The configured first-body backend (:data:`tribodem.contact.BACKENDS`) on the case."""
     c = cfg.contact
@@ -776,7 +794,7 @@ def build_solver(cfg: FrettingConfig) -> FirstBodySolver:
         kw |= cfg.plastic.model_dump()
     if "line" in backend.capabilities.contacts and not isinstance(geo, HeightMaps):
         kw["contact"] = geo.contact
-    if backend in (FEContactSolver, BACKENDS["fe3d"]):
+    if backend in ccx_backends():
         fe = {k: v for k, v in cfg.fe.model_dump().items()
               if v is not None or k not in FE_BACKEND_OWN}
         fe["threads"] = runs.check_threads(fe["threads"], "fe.threads (--threads)")
@@ -878,7 +896,10 @@ def _flat(d: dict[str, Any], prefix: str = "") -> dict[str, Any]:
 
 
 def _jsonable(cfg: FrettingConfig) -> dict[str, Any]:
-    return json.loads(json.dumps(cfg.model_dump()))
+    """``cfg`` as JSON-able nested dicts, as it is recorded (config.toml, summary.json, the
+    checkpoint, study.toml): every field, the fields' JSON forms ('off' for no slope
+    limit)."""
+    return cfg.model_dump(mode="json")
 
 
 #: ``[fe]`` defaults that tribodem recorded in every config before ``config_version`` 2 (it
@@ -916,7 +937,7 @@ def effective_config(data: dict[str, Any]) -> dict[str, Any]:
         return data
     backend = BACKENDS.get(str(data.get("solver")))
     out = {k: v for k, v in fe.items() if k not in FE_BACKEND_OWN}
-    if backend in (FEContactSolver, BACKENDS["fe3d"]):
+    if backend in ccx_backends():
         takes = inspect.signature(backend).parameters
         out |= {k: takes[k].default if fe.get(k) is None else fe[k] for k in FE_BACKEND_OWN}
     return {**data, "fe": out}
@@ -931,12 +952,12 @@ RESUME_MAY_CHANGE = ("cycles", "output.", "fe.threads", "fe.timeout", "fe.cache"
                      "fe.retries", "fe.max_wear_slope")
 
 
-def resume_diffs(old_cfg: dict[str, Any], new_cfg: dict[str, Any],
-                 what: str = "checkpoint") -> list[str]:
+def resume_diffs(old_cfg: dict[str, Any], new_cfg: dict[str, Any], what: str = "checkpoint",
+                 may_change: tuple[str, ...] = RESUME_MAY_CHANGE) -> list[str]:
     """The fields in which config ``new_cfg`` would make another run than the recorded
     config ``old_cfg`` (read as :func:`recorded_config` reads it), each as "field = new
     (``what``: old)": both compared as :func:`effective_config` gives them, without the
-    fields a resume may change (:data:`RESUME_MAY_CHANGE`) and without a field added to
+    fields a resume may change (``may_change``, prefixes) and without a field added to
     tribodem after the record was made that ``new_cfg`` leaves at its default (it keeps the
     behaviour the record ran with)."""
     old = _flat(effective_config(recorded_config(old_cfg)))
@@ -945,13 +966,14 @@ def resume_diffs(old_cfg: dict[str, Any], new_cfg: dict[str, Any],
     default = _flat(_jsonable(FrettingConfig()))
     return [f"{k} = {new.get(k, absent)!r} ({what}: {old.get(k, absent)!r})"
             for k in sorted(set(old) | set(new))
-            if not k.startswith(RESUME_MAY_CHANGE) and old.get(k, absent) != new.get(k, absent)
+            if not k.startswith(may_change) and old.get(k, absent) != new.get(k, absent)
             and not (k not in old and k in default and new.get(k) == default[k])]
 
 
-#: what a refused resume says may change
-RESUME_ALLOWED = ("only cycles, to extend the run, the [output] table and fe.threads / "
-                  "timeout / cache / retries / max_wear_slope may change")
+def resume_allowed(may_change: tuple[str, ...] = RESUME_MAY_CHANGE) -> str:
+    """What a refused resume says may change (``may_change``: field names and prefixes)."""
+    return "only " + ", ".join(f"[{k[:-1]}]" if k.endswith(".") else k
+                               for k in may_change) + " may change"
 
 
 def check_resume(cfg: FrettingConfig, meta: dict[str, Any], path: Path) -> None:
@@ -962,7 +984,8 @@ def check_resume(cfg: FrettingConfig, meta: dict[str, Any], path: Path) -> None:
     if diffs:
         raise ConfigError(
             f"--resume: the config differs from the one checkpoint '{path}' was made with: "
-            + "; ".join(diffs) + f"; allowed: the checkpoint's values ({RESUME_ALLOWED})")
+            + "; ".join(diffs) + f"; allowed: the checkpoint's values ({resume_allowed()}; "
+            "cycles to extend the run)")
     done = int(meta.get("cycles_done", 0))
     if cfg.cycles < done:
         raise ConfigError(f"cycles = {cfg.cycles}: checkpoint '{path}' is already at cycle "
@@ -990,7 +1013,7 @@ def run_fretting(cfg: FrettingConfig, out: Path, echo: Any = None, resume: bool 
         meta, state = checkpoint if checkpoint is not None else read_checkpoint(ck)
         check_resume(cfg, meta, ck)
     loop = build_loop(cfg)
-    if isinstance(loop.solver, (FEContactSolver, BACKENDS["fe3d"])):  # ccx decks, logs, results
+    if isinstance(loop.solver, ccx_backends()):  # ccx decks, logs, results
         loop.solver.workdir = out / "fe"
     if state is not None:
         try:
@@ -1226,7 +1249,7 @@ def debris_study_cmd(
     runs.check_out_dir(out, "--out", resume=resume, need=("study.toml",) if resume else ())
     # a resume takes the study's own config and counts unless they are given again
     study = read_study(out) if resume else {}
-    default = ",".join(str(c) for c in study["counts"]) if resume else \
+    default = ",".join(str(c) for c in study.get("counts") or ()) if resume else \
         QUICK_STUDY_COUNTS if quick else ",".join(str(c) for c in SEED_COUNTS)
     wanted = parse_counts(counts if counts is not None else default)
     ov: dict[str, Any] = {}

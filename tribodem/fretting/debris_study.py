@@ -325,10 +325,11 @@ def run_debris_study(cfg: Any, out: Path, counts: tuple[int, ...] = SEED_COUNTS,
     stages and resumes the wear run from its checkpoint.
     """
     from tribodem.fretting.cli import (
-        RESUME_ALLOWED,
+        RESUME_MAY_CHANGE,
         _jsonable,
         build_loop,
         debris_settings,
+        resume_allowed,
         run_fretting,
     )
     from tribodem.fretting.output import CHECKPOINT, read_checkpoint
@@ -350,11 +351,13 @@ def run_debris_study(cfg: Any, out: Path, counts: tuple[int, ...] = SEED_COUNTS,
     meta = {"config": _jsonable(cfg), "counts": [int(c) for c in counts]}
     if resume:
         old = out / "study.toml"
-        diffs = study_diffs(out, meta)
+        # the study's cycle is its debris phases' cycle: it may not change
+        may = tuple(k for k in RESUME_MAY_CHANGE if k != "cycles")
+        diffs = study_diffs(out, meta, may_change=may)
         if diffs:
             raise ConfigError(f"--resume: the config or counts differ from the study in "
                               f"'{out}' ({old}): {'; '.join(diffs)}; allowed: the same "
-                              f"config and --counts ({RESUME_ALLOWED})")
+                              f"config and --counts ({resume_allowed(may)})")
     else:
         for stale in [*out.glob("count_*.json"), *out.glob("count_*.npz")]:
             stale.unlink()
@@ -435,25 +438,31 @@ def read_study(out: Path) -> dict[str, Any]:
     :func:`~tribodem.fretting.cli.recorded_config` reads a recorded one (``ConfigError``
     naming ``--out`` when it cannot be read)."""
     from tribodem.fretting.cli import recorded_config
-    from tribodem.io.config import load_toml
+    from tribodem.io.config import ConfigError, load_toml
 
-    data = load_toml(Path(out) / "study.toml", "--out")
-    if isinstance(data.get("config"), dict):
-        data["config"] = recorded_config(data["config"])
+    path = Path(out) / "study.toml"
+    data = load_toml(path, "--out")
+    if not isinstance(data.get("config"), dict):
+        raise ConfigError(f"--out: '{path}' has no [config] table; allowed: the study.toml "
+                          "a study wrote (or a new --out without --resume)")
+    data["config"] = recorded_config(data["config"])
     return load_toml_roundtrip(data)
 
 
-def study_diffs(out: Path, meta: dict[str, Any]) -> list[str]:
+def study_diffs(out: Path, meta: dict[str, Any],
+                may_change: tuple[str, ...] | None = None) -> list[str]:
     """What keeps the study ``meta`` (its ``config`` and the rest: ``quick``, ``counts``)
     from resuming the one ``out/study.toml`` records (:func:`read_study`), each as "field =
     new (study: old)": the configs compared as a run's resume compares them
     (:func:`~tribodem.fretting.cli.resume_diffs`: how ccx runs, ``[output]`` and ``cycles``
-    may change), the rest by equality. Empty when it may resume."""
-    from tribodem.fretting.cli import resume_diffs
+    may change, or the fields of ``may_change``), the rest by equality. Empty when it may
+    resume."""
+    from tribodem.fretting.cli import RESUME_MAY_CHANGE, resume_diffs
 
     old = read_study(out)
     new = load_toml_roundtrip(meta)
-    diffs = resume_diffs(old.get("config") or {}, new.get("config") or {}, what="study")
+    diffs = resume_diffs(old["config"], new.get("config") or {}, what="study",
+                         may_change=RESUME_MAY_CHANGE if may_change is None else may_change)
     return diffs + [f"{k} = {new.get(k)!r} (study: {old.get(k)!r})"
                     for k in sorted((set(old) | set(new)) - {"config"})
                     if old.get(k) != new.get(k)]

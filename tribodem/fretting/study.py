@@ -257,14 +257,14 @@ def run_study(cfg: Any, out: Path, quick: bool = False, resume: bool = False,
         raise ConfigError(str(err)) from None
     meta = {"config": _jsonable(cfg), "quick": bool(quick)}
     if resume:
-        from tribodem.fretting.cli import RESUME_ALLOWED
+        from tribodem.fretting.cli import resume_allowed
         from tribodem.fretting.debris_study import study_diffs
 
         diffs = study_diffs(out, meta)
         if diffs:
             raise ConfigError(f"--resume: the config differs from the study in '{out}': "
                               f"{'; '.join(diffs)}; allowed: the study's values (and its "
-                              f"--quick; {RESUME_ALLOWED})")
+                              f"--quick; {resume_allowed()})")
     out.mkdir(parents=True, exist_ok=True)
     write_text(out / "study.toml", dump_toml(meta))
     rows: list[dict[str, Any]] = []
