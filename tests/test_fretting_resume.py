@@ -450,3 +450,9 @@ def test_a_recorded_config_reloads_to_the_same_config(tmp_path: Path) -> None:
     path.write_text(dump_toml(_jsonable(cfg)))
     assert FrettingConfig.model_validate(recorded_config(load_toml(path))) == cfg
     assert resolve_config(None, base=recorded_config(load_toml(path))) == cfg
+    # and the run's own config.toml, given back with --config
+    out = tmp_path / "run"
+    run_fretting(resolve_config(None, quick=True, overrides={
+        "cycles": 1, "fe": {"max_wear_slope": "off"}, "output": {"figures": False,
+                                                                 "vtk": False}}), out)
+    assert resolve_config(out / "config.toml").fe.max_wear_slope is None

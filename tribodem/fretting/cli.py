@@ -1027,7 +1027,7 @@ def run_fretting(cfg: FrettingConfig, out: Path, echo: Any = None, resume: bool 
     out.mkdir(parents=True, exist_ok=True)
     if not resume:  # a new run: an older run's checkpoint must not pass for this one's
         ck.unlink(missing_ok=True)
-    resolved = cfg.model_dump()
+    resolved = _jsonable(cfg)
     write_text(out / "config.toml", dump_toml(resolved))
     t0 = time.perf_counter()
     every = max(1, cfg.cycles // 10)
