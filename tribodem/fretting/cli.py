@@ -369,7 +369,9 @@ class FEConfig(_Model):
 #: Layout version of the fretting config, recorded as ``config_version`` in every config
 #: tribodem writes (config.toml, summary.json, checkpoint.npz, study.toml). 2: ``[fe]
 #: h_over_a`` / ``size_factor`` left out are the backend's own (:data:`FE_BACKEND_OWN`); a
-#: recorded config without it is older (:func:`recorded_config`).
+#: recorded config without it is older (:func:`recorded_config`). A version 3 must let the
+#: field take 2 as well and have :func:`recorded_config` migrate a version-2 record (users
+#: give runs' config.toml back with --config, and old checkpoints resume).
 CONFIG_VERSION = 2
 
 
