@@ -542,3 +542,31 @@ def test_job_cache_serves_the_same_job_without_running_ccx(tmp_path: Path) -> No
     rows = (tmp_path / "second" / "jobs.csv").read_text().splitlines()
     assert rows[0].split(",")[-2:] == ["cached", "deck"] and rows[1].split(",")[-2] == "1"
     assert len(list((tmp_path / "cache").iterdir())) == 2  # two decks, no temporary left
+
+
+def test_a_failure_record_names_the_build_not_the_file(tmp_path: Path) -> None:
+    """A ``.failed`` record's key is the deck and the ccx build by what it is (version,
+    solvers, patches), so it holds for the same build at another path or made anew (a run
+    carried to another machine); the job cache's key stays the file's (results of two
+    builds agree within tolerances only)."""
+    import os
+    import shutil
+
+    from tribodem.contact.fe import jobs
+    from tribodem.contact.fe.ccx import resolve_ccx
+
+    exe = resolve_ccx(None)
+    if exe is None:
+        pytest.skip("no ccx")
+    copies = []
+    for k, name in enumerate(("a", "b")):
+        (tmp_path / name).mkdir()
+        copies.append(str(shutil.copy2(exe, tmp_path / name / "ccx")))
+        os.utime(copies[-1], ns=(10**18 + k, 10**18 + k))
+    deck = tmp_path / "job.inp"
+    deck.write_text("*HEADING\nsame deck\n")
+    assert jobs._failure_key(deck, copies[0]) == jobs._failure_key(deck, copies[1])
+    assert jobs._cache_key(deck, copies[0]) != jobs._cache_key(deck, copies[1])
+    other = tmp_path / "other.inp"
+    other.write_text("*HEADING\nanother deck\n")
+    assert jobs._failure_key(other, copies[0]) != jobs._failure_key(deck, copies[0])

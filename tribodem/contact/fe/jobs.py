@@ -28,6 +28,7 @@ from tribodem.contact.fe.ccx import (
     CcxConvergenceError,
     CcxRun,
     FESolverStopped,
+    ccx_build,
     resolve_ccx,
     run_ccx,
 )
@@ -123,11 +124,24 @@ def _to_cache(run: CcxRun, cache: Path, key: str) -> None:
         shutil.rmtree(tmp, ignore_errors=True)
 
 
-#: beside a deck that did not converge: its key (``_cache_key``) on the first line, then
+#: beside a deck that did not converge: its key (``_failure_key``) on the first line, then
 #: ccx's message. ``run_job`` does not run a deck with that key again (a resumed run goes
 #: on from the next attempt); delete the file to run it again (ccx with PARDISO on several
 #: threads sums in another order each run, so a failed deck may pass another time).
 FAILED_SUFFIX = ".failed"
+
+
+def _failure_key(deck: Path, executable: str | None) -> str:
+    """The deck's bytes and the ccx build by what it is (version line, solvers, patches:
+    :func:`~tribodem.contact.fe.ccx.ccx_build`), not by its file as ``_cache_key``: a
+    record carried to another machine (``tools/carry_run``), whose ``tools/build_ccx_pardiso``
+    made the same build anew, still skips the attempt that failed."""
+    h = hashlib.sha256(deck.read_bytes())
+    exe = resolve_ccx(executable)
+    if exe:
+        b = ccx_build(exe)
+        h.update(f"{b['version']}|{','.join(b['solvers'])}|{','.join(b['patches'])}".encode())
+    return h.hexdigest()[:32]
 
 
 def _known_failure(deck: Path, key: str) -> str | None:
@@ -177,7 +191,8 @@ def run_job(write: Callable[[int, str, float], Path], retries: int, threads: int
             hit = _from_cache(deck, cache, key)
             if hit is not None:
                 return hit, refine, scale, t_deck, t_ccx
-        known = _known_failure(deck, key)
+        fkey = _failure_key(deck, executable)
+        known = _known_failure(deck, fkey)
         if known is not None:  # this very deck failed here before: the next attempt
             if attempt == retries:
                 raise CcxConvergenceError(
@@ -189,7 +204,7 @@ def run_job(write: Callable[[int, str, float], Path], retries: int, threads: int
             run = run_ccx(deck, threads=threads, timeout=timeout, executable=executable)
         except CcxConvergenceError as err:
             t_ccx += time.perf_counter() - t2
-            write_text(deck.with_suffix(FAILED_SUFFIX), f"{key}\n{err}")
+            write_text(deck.with_suffix(FAILED_SUFFIX), f"{fkey}\n{err}")
             if attempt == retries:
                 raise
             continue
