@@ -1033,7 +1033,7 @@ def run_fretting(cfg: FrettingConfig, out: Path, echo: Any = None, resume: bool 
     write_text(out / "config.toml", dump_toml(resolved))
     t0 = time.perf_counter()
     every = max(1, cfg.cycles // 10)
-    meta_cfg = _jsonable(cfg)
+    meta_cfg = resolved  # the checkpoint records the config as config.toml does
 
     def save(lp: FrettingLoop) -> None:
         assert lp.history is not None
