@@ -195,6 +195,67 @@ def test_retries_halve_the_increments_then_the_penalty(tmp_path: Path,
     assert [w[0] for w in written] == ["job", "job_refine2"]
 
 
+def test_retry_from_last_starts_where_the_previous_job_converged(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """``run_job(start=k)`` writes and runs no attempt before ``k`` (``[fe] retry_from =
+    "last"``); ``attempt_index`` inverts ``attempt_settings``; ``start`` beyond ``retries``
+    runs the last attempt only."""
+    from types import SimpleNamespace
+
+    from tribodem.contact.fe import jobs
+
+    for a in range(9):
+        assert jobs.attempt_index(*jobs.attempt_settings(a)) == a
+    with pytest.raises(ValueError, match="no attempt"):
+        jobs.attempt_index(3, 1.0)
+    ran: list[str] = []
+    monkeypatch.setattr(jobs, "run_ccx", lambda deck, **kw: (
+        ran.append(deck.name), SimpleNamespace(job=deck.with_suffix(""), cached=False))[1])
+
+    def write(refine: int, name: str, scale: float) -> Path:
+        deck = tmp_path / f"{name}.inp"
+        deck.write_text(f"{refine} {scale}\n")
+        return deck
+
+    _, refine, scale, _, _ = jobs.run_job(write, 4, 1, 60.0, None, start=3)
+    assert ran == ["job_refine4_soft2.inp"] and (refine, scale) == (4, 0.5)
+    ran.clear()
+    _, refine, scale, _, _ = jobs.run_job(write, 2, 1, 60.0, None, start=4)
+    assert ran == ["job_refine2_soft2.inp"] and (refine, scale) == (2, 0.5)
+
+
+def test_a_backend_keeps_its_last_attempt_across_a_resume(tmp_path: Path) -> None:
+    """A ccx backend records the attempt its last job converged on in its state (a
+    resumed run starts where the uninterrupted one would); a state saved before that was
+    kept takes it from the run's ``jobs.csv`` (its last row's refine and penalty scale);
+    ``retry_from = "first"`` always starts at the configured job."""
+    from fe3d_cases import _solver
+
+    from tribodem.contact.fe import jobs
+
+    s = _solver(tmp_path, retries=4, retry_from="last")
+    assert s._first_attempt() == 0
+    s._last_attempt = 4
+    assert s._first_attempt() == 4
+    state = s.state_dict()
+    other = _solver(tmp_path / "b", retries=3, retry_from="last")
+    other.load_state_dict(state)
+    assert other._first_attempt() == 3  # no further than its own retries
+    first = _solver(tmp_path / "c", retries=4)
+    first.load_state_dict(state)
+    assert first._last_attempt == 4 and first._first_attempt() == 0
+    old = {k: v for k, v in state.items() if k != "last_attempt"}
+    (tmp_path / "d").mkdir()
+    row = dict.fromkeys(jobs.JOB_COLUMNS, "0") | {"refine": "4", "penalty_scale": "0.5"}
+    jobs.write_csv(tmp_path / "d" / "jobs.csv", jobs.JOB_COLUMNS, [list(row.values())])
+    old["workdir"] = str(tmp_path / "d")
+    older = _solver(None, retries=4, retry_from="last")
+    older.load_state_dict(old)
+    assert older._first_attempt() == 3
+    with pytest.raises(ValueError, match="retry_from = 'middle' is not allowed"):
+        _solver(tmp_path / "e", retry_from="middle")
+
+
 def test_a_failed_deck_is_not_run_again(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """A deck that did not converge leaves a ``.failed`` record (its key, ccx's message):
     the same deck is skipped the next time (a resumed run goes on from the next attempt),

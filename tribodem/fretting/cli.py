@@ -340,6 +340,11 @@ class FEConfig(_Model):
     retries: int = Field(1, ge=0, le=4, description="retries after a non-convergence: "
                          "halved increments, then also a contact half as stiff, alternately "
                          "(jobs.attempt_settings; 1: halved increments only)")
+    retry_from: Literal["first", "last"] = Field(
+        "first", description="where a cycle's ccx attempts start: first, the job as "
+        "configured (every cycle); last, the attempt on which the previous cycle converged "
+        "(the attempts before it are not run; a worn geometry that needed a finer or softer "
+        "attempt mostly needs it again: docs/fe.md)")
     cache: str | None = Field(None, description="folder of finished ccx jobs keyed by the "
                               "deck's bytes and the ccx build: a deck found there is not run "
                               "again (the chapter 6 study shares one across its stages)")
@@ -951,7 +956,7 @@ def effective_config(data: dict[str, Any]) -> dict[str, Any]:
 #: surface's slope limit (the cycles after the resume are then another run's: each cycle's
 #: ``wear_slope_limit`` in summary.json says whether it had one).
 RESUME_MAY_CHANGE = ("cycles", "output.", "fe.threads", "fe.timeout", "fe.cache",
-                     "fe.retries", "fe.max_wear_slope")
+                     "fe.retries", "fe.retry_from", "fe.max_wear_slope")
 
 
 def resume_diffs(old_cfg: dict[str, Any], new_cfg: dict[str, Any], what: str = "checkpoint",

@@ -70,7 +70,13 @@ from tribodem.contact.fe.ccx import (
     find_ccx,
 )
 from tribodem.contact.fe.deck import LoadCase, sliding_contact, write_deck
-from tribodem.contact.fe.jobs import CcxJobs, JobRecord, check_stress_depth, run_job
+from tribodem.contact.fe.jobs import (
+    CcxJobs,
+    JobRecord,
+    attempt_index,
+    check_stress_depth,
+    run_job,
+)
 from tribodem.contact.fe.mesh import (
     Mesh,
     PadOnFlat,
@@ -226,6 +232,7 @@ class FEContactSolver(CcxJobs, FirstBodySolver):
         threads: int = 1,
         timeout: float = 1800.0,
         retries: int = 1,
+        retry_from: str = "first",
         cache: str | Path | None = None,
         workdir: str | Path | None = None,
         executable: str | None = None,
@@ -307,6 +314,7 @@ class FEContactSolver(CcxJobs, FirstBodySolver):
         if int(retries) != retries or retries < 0:
             raise ValueError(f"retries = {retries!r} is not allowed: an integer >= 0")
         self.retries = int(retries)
+        self._set_retry_from(retry_from)
         #: folder of finished ccx jobs keyed by deck (:func:`.jobs.run_job`; None: no cache)
         self.cache: Path | None = None if cache is None else Path(cache)
         self.workdir: Path | None = None if workdir is None else Path(workdir)
@@ -491,8 +499,10 @@ class FEContactSolver(CcxJobs, FirstBodySolver):
                               stress_sets=("LCOL", "UCOL"))
 
         run, refine, scale, t_deck, t_ccx = run_job(write, self.retries, self.threads,
-                                                    self.timeout, self.executable, self.cache)
+                                                    self.timeout, self.executable, self.cache,
+                                                    start=self._first_attempt())
         self._penalty_scale = scale
+        self._last_attempt = attempt_index(refine, scale)
         t_mesh += t_deck
         t3 = time.perf_counter()
         res = read_results(run.job, mesh)
@@ -897,6 +907,7 @@ class FEContactSolver(CcxJobs, FirstBodySolver):
                 "material": self.material, "chain": chain,
                 "chain_restarts": self.chain_restarts,
                 "cycle_reports": list(self.cycle_reports),
+                "last_attempt": self._last_attempt,
                 "workdir": None if self.workdir is None else str(self.workdir)}
 
     def load_state_dict(self, state: dict[str, Any]) -> None:
@@ -920,3 +931,5 @@ class FEContactSolver(CcxJobs, FirstBodySolver):
         self.cycle_reports = list(state.get("cycle_reports", []))
         if self.workdir is None and state.get("workdir"):
             self.workdir = Path(state["workdir"])
+        self._restore_last_attempt(
+            state, math.ceil(self.plastic_increments / self.n_increments) if self.plastic else 1)

@@ -103,7 +103,13 @@ from tribodem.contact.fe.deck import (
     _write_ids,
     sliding_contact,
 )
-from tribodem.contact.fe.jobs import CcxJobs, JobRecord, check_stress_depth, run_job
+from tribodem.contact.fe.jobs import (
+    CcxJobs,
+    JobRecord,
+    attempt_index,
+    check_stress_depth,
+    run_job,
+)
 from tribodem.contact.fe.mesh import surface_projection, worn_depth
 from tribodem.contact.fe.results import DatBlock, read_dat
 from tribodem.contact.fe.slope import SlopeLimit, limit_slope, steepest
@@ -339,6 +345,7 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         threads: int = 1,
         timeout: float = 14400.0,
         retries: int = 1,
+        retry_from: str = "first",
         cache: str | Path | None = None,
         max_wear_slope: float | None = CONVERGED_SLOPE,
         workdir: str | Path | None = None,
@@ -421,6 +428,7 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         if int(retries) != retries or retries < 0:
             raise ValueError(f"retries = {retries!r} is not allowed: an integer >= 0")
         self.retries = int(retries)
+        self._set_retry_from(retry_from)
         if max_wear_slope is not None and not (math.isfinite(max_wear_slope)
                                                and max_wear_slope > 0.0):
             raise ValueError(f"max_wear_slope = {max_wear_slope!r} is not allowed: a number "
@@ -846,13 +854,15 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
             run, refine, scale, t_deck, t_ccx = run_job(
                 lambda refine, name, scale: self.write_deck(folder / f"{name}.inp", mesh,
                                                             seat, refine, scale),
-                self.retries, self.threads, self.timeout, self.executable, self.cache)
+                self.retries, self.threads, self.timeout, self.executable, self.cache,
+                start=self._first_attempt())
         except CcxConvergenceError as err:
             hint = self._steepness_hint()
             if hint:
                 raise FESolverStopped(f"{err}\n{hint}") from None
             raise
         self._penalty_scale = scale
+        self._last_attempt = attempt_index(refine, scale)
         t_mesh += t_deck
         t3 = time.perf_counter()
         blocks = read_dat(run.dat)
@@ -1302,6 +1312,7 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         return {"cycle": self._cycle, "loaded": self._loaded, "mode": self.mode,
                 "material": self.material, "cycle_reports": list(self.cycle_reports),
                 "debris_pressure": self._debris_pressure.copy(), "debris_load": self._debris_load,
+                "last_attempt": self._last_attempt,
                 "workdir": None if self.workdir is None else str(self.workdir)}
 
     def load_state_dict(self, state: dict[str, Any]) -> None:
@@ -1324,3 +1335,4 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
             self._debris_load = float(state["debris_load"])
         if self.workdir is None and state.get("workdir"):
             self.workdir = Path(state["workdir"])
+        self._restore_last_attempt(state)

@@ -162,11 +162,28 @@ def attempt_settings(attempt: int) -> tuple[int, float]:
     return 2 ** ((attempt + 1) // 2), 0.5 ** (attempt // 2)
 
 
+def attempt_index(refine: int, scale: float) -> int:
+    """The attempt of :func:`attempt_settings` that runs at increment refinement ``refine``
+    and contact penalty scale ``scale`` (``ValueError`` for a pair no attempt has)."""
+    for attempt in range(2 * int(math.log2(max(int(refine), 1))) + 2):
+        if attempt_settings(attempt) == (int(refine), float(scale)):
+            return attempt
+    raise ValueError(f"no attempt runs at refine {refine!r}, penalty scale {scale!r}")
+
+
+#: where a job's attempts start (``[fe] retry_from``): ``first``, the job as configured
+#: (every job); ``last``, the attempt on which the previous job converged (the attempts
+#: before it are not run: a worn geometry that needed a finer or softer attempt in one cycle
+#: mostly needs it in the next, and each failed attempt costs up to a whole job)
+RETRY_FROM = ("first", "last")
+
+
 def run_job(write: Callable[[int, str, float], Path], retries: int, threads: int,
-            timeout: float, executable: str | None, cache: Path | None = None
-            ) -> tuple[CcxRun, int, float, float, float]:
+            timeout: float, executable: str | None, cache: Path | None = None,
+            start: int = 0) -> tuple[CcxRun, int, float, float, float]:
     """Write and run one ccx job, retrying a non-converging one (``retries`` more attempts,
-    :func:`attempt_settings`; the last failure is raised).
+    :func:`attempt_settings`; the last failure is raised). ``start``: the first attempt
+    run (0: the job as configured; at most ``retries``; see :data:`RETRY_FROM`).
 
     ``write(refine, name, penalty_scale)`` writes the deck ``name`` (``job``,
     ``job_refine2``, ``job_refine2_soft2``, ...) at that refinement and contact penalty scale
@@ -178,7 +195,7 @@ def run_job(write: Callable[[int, str, float], Path], retries: int, threads: int
     (the run, its refinement, its penalty scale, seconds writing decks, seconds in ccx over
     all attempts)."""
     t_deck = t_ccx = 0.0
-    for attempt in range(retries + 1):
+    for attempt in range(min(max(int(start), 0), retries), retries + 1):
         refine, scale = attempt_settings(attempt)
         name = "job" if attempt == 0 else f"job_refine{refine}"
         if scale != 1.0:
@@ -252,6 +269,40 @@ class CcxJobs:
     mesh: Any  #: the (morphed) mesh of the last job (``h_fine``, m)
     #: the contact penalty scale of the last job's converged attempt (:func:`attempt_settings`)
     _penalty_scale: float = 1.0
+    retries: int
+    #: where a job's attempts start (:data:`RETRY_FROM`)
+    retry_from: str = "first"
+    #: the attempt on which the last job converged (:func:`attempt_index`; kept in the
+    #: backend's state, so a resumed run starts where the uninterrupted one would)
+    _last_attempt: int = 0
+
+    def _set_retry_from(self, retry_from: str) -> None:
+        """Check and keep ``retry_from`` (:data:`RETRY_FROM`)."""
+        if retry_from not in RETRY_FROM:
+            raise ValueError(f"retry_from = {retry_from!r} is not allowed: allowed: "
+                             f"{', '.join(RETRY_FROM)}")
+        self.retry_from = retry_from
+
+    def _first_attempt(self) -> int:
+        """The attempt the next job starts at (:data:`RETRY_FROM`)."""
+        return min(self._last_attempt, self.retries) if self.retry_from == "last" else 0
+
+    def _restore_last_attempt(self, state: dict[str, Any], refine_unit: int = 1) -> None:
+        """``_last_attempt`` from a saved state, else (a state saved before it was kept)
+        from the last row of the run's ``jobs.csv`` (its refine divided by
+        ``refine_unit``, the job's own refinement of the cycle), else 0."""
+        if "last_attempt" in state:
+            self._last_attempt = int(state["last_attempt"])
+            return
+        rows = prior_job_rows(self.workdir / "jobs.csv") if self.workdir is not None else []
+        self._last_attempt = 0
+        if rows:
+            row = dict(zip(JOB_COLUMNS, rows[-1], strict=True))
+            try:
+                self._last_attempt = attempt_index(int(row["refine"]) // refine_unit,
+                                                   float(row["penalty_scale"]))
+            except ValueError:
+                pass
 
     def _scaled_settings(self, scale: float) -> ContactSettings:
         """``settings`` with the penalty stiffnesses (normal, and the stick slope with it)
