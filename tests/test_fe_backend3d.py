@@ -254,6 +254,9 @@ def served(tmp_path_factory: pytest.TempPathFactory):  # noqa: ANN201
 def test_hertz_point_contact(served) -> None:  # noqa: ANN001
     solver, loaded, _ = served
     assert len(solver.jobs) == 1  # the loading and the first cycle: one job
+    job, rep = solver.jobs[0], solver.report()["cycles"][0]  # the attempt it converged on
+    assert (rep["attempt_refine"], rep["contact_penalty_scale"]) == (job.refine,
+                                                                     job.penalty_scale)
     cell = solver.dx**2
     assert loaded.normal_load == pytest.approx(LOAD, rel=1e-3)
     p = loaded.pressure

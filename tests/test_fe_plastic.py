@@ -18,6 +18,7 @@ import numpy as np
 import pytest
 from conftest import run_tribodem
 
+from tribodem.contact.fe import jobs
 from tribodem.contact.fe.deck import FEMaterial
 from tribodem.materials.en24t import EN24T
 
@@ -101,6 +102,9 @@ def test_chained_plastic_cycles_accumulate_and_resume(tmp_path: Path) -> None:
     # which ccx ran is part of the result (two builds agree within tolerances, not bits)
     assert "SPOOLES" in rep["ccx"]["solvers"] and "Version" in rep["ccx"]["version"]
     assert [c["job_cycle"] for c in rep["cycles"]] == [1, 2]
+    for c in rep["cycles"]:  # the attempt its job converged on (a softer contact wears less)
+        assert jobs.attempt_settings(c["ccx_attempt"]) == (c["attempt_refine"],
+                                                           c["contact_penalty_scale"]), c
     law = FEMaterial(yield_strength=EN24T.yield_strength)
     (y, _), (uts, p_uts) = law.plastic_table()
     h = (uts - y) / p_uts

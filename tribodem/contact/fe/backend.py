@@ -825,7 +825,8 @@ class FEContactSolver(CcxJobs, FirstBodySolver):
         times = [float(t) for t in self.cycle_times(pos)]
         if pos == 1:
             times = [float(t) for t in self._loading_times()] + times
-        row: dict[str, Any] = {"cycle": self._cycle + 1, "job_cycle": pos}
+        row: dict[str, Any] = ({"cycle": self._cycle + 1, "job_cycle": pos}
+                               | self._attempt_report())
         vm_max = s22_c = s22_t = 0.0
         for set_name in ("UCOL", "LCOL"):
             for t in times:
@@ -884,7 +885,8 @@ class FEContactSolver(CcxJobs, FirstBodySolver):
         of the pad's towards the flat) and dent (deepest residual depression); the largest
         shear traction in
         the cycle's first and last quarters and the drop between them (last / first - 1),
-        |Q| / (mu P) at +A and -A."""
+        |Q| / (mu P) at +A and -A; the ccx attempt its job converged on
+        (:meth:`.jobs.CcxJobs._attempt_report`)."""
         return {"backend": "fe", "mode": self.mode, "material": self.material,
                 "ccx": ccx_build(self.executable),
                 "chain_cycles": self.chain_cycles if self.mode == "chained" else None,

@@ -1201,7 +1201,7 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         """Peak stresses, plastic strain, pile-up and traction of the job just run (one
         fretting cycle from virgin bodies); see :meth:`report`."""
         times = sorted(self._state_of)
-        row: dict[str, Any] = {"cycle": self._cycle + 1}
+        row: dict[str, Any] = {"cycle": self._cycle + 1} | self._attempt_report()
         peaks = np.zeros((len(times), 3))  # per output time: von Mises, -S33, S33
         for name in ("UCOL", "LCOL"):
             for k, t in enumerate(times):
@@ -1267,7 +1267,8 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         (``max_peeq_loaded_*``: Johnson's first yield, below the surface), the residual
         pile-up and dent
         after lifting the upper body off; the largest shear traction in the cycle's first
-        and last quarters and the drop between them, |Q| / (mu P) at +A and -A."""
+        and last quarters and the drop between them, |Q| / (mu P) at +A and -A; the ccx
+        attempt the cycle's job converged on (:meth:`.jobs.CcxJobs._attempt_report`)."""
         return {"backend": "fe3d", "mode": self.mode, "material": self.material,
                 "ccx": ccx_build(self.executable),
                 "fe3d": {"elements": int(self._mesh0.elements.shape[0]),

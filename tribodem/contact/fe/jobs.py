@@ -287,6 +287,14 @@ class CcxJobs:
         """The attempt the next job starts at (:data:`RETRY_FROM`)."""
         return min(self._last_attempt, self.retries) if self.retry_from == "last" else 0
 
+    def _attempt_report(self) -> dict[str, Any]:
+        """The last job's converged attempt, for its cycles' reports (summary.json): its
+        index, increment refinement and contact penalty scale (:func:`attempt_settings`; a
+        softened contact changes the fields, docs/fe.md ``retry_from``)."""
+        refine, scale = attempt_settings(self._last_attempt)
+        return {"ccx_attempt": self._last_attempt, "attempt_refine": refine,
+                "contact_penalty_scale": scale}
+
     def _restore_last_attempt(self, state: dict[str, Any], refine_unit: int = 1) -> None:
         """``_last_attempt`` from a saved state, else (a state saved before it was kept)
         from the last row of the run's ``jobs.csv`` (its refine divided by
