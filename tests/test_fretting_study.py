@@ -103,6 +103,26 @@ def test_jump_reading_reaches_study_md(tmp_path: Path) -> None:
     assert f"shear_jump, cycle-jumping: {summary['jump']['reading']}." in md
 
 
+def test_softened_cycles_reach_study_md(tmp_path: Path) -> None:
+    """A stage whose cycles converged only on a softened contact (the retry ladder, or
+    ``retry_from = "last"``) says which, in its row and in study.md (it wears less)."""
+    summary = {"cycles": 6, "cycles_simulated": 6, "wear_depth_mean_scar_lower_m": 3e-6,
+               "wear_depth_mean_scar_upper_m": 4e-6, "wear_depth_lower_m": 8e-6,
+               "wear_depth_upper_m": 9e-6, "wear_volume_lower_m3": 1e-13, "wall_time_s": 1.0,
+               "first_body_report": {"cycles": [
+                   {"cycle": c, "contact_penalty_scale": p, "max_von_mises_pa": 1e9,
+                    "max_s22_compressive_pa": 2e9}
+                   for c, p in zip(range(1, 7), (1.0, 1.0, 0.5, 0.25, 1.0, 0.25),
+                                   strict=True)]}}
+    row = row_of(Stage("shear", "shear", 6), summary)
+    assert row["softened_cycles"] == [3, 4, 6] and row["softest_penalty_scale"] == 0.25
+    md = write_markdown(tmp_path, [row], compare([row]), ranking([row]), "fe3d").read_text()
+    assert "shear: cycle(s) 3-4, 6 of 6 converged only on a softened contact (penalty x 0.25" in md
+    assert "softened_cycles" not in row_of(Stage("shear", "shear", 6), {
+        **summary, "first_body_report": {"cycles": [{"cycle": 1, "max_von_mises_pa": 1e9,
+                                                     "max_s22_compressive_pa": 2e9}]}})
+
+
 def test_study_command(tmp_path: Path) -> None:
     """The study through the installed command on a small grid (stages von_mises, dfdi,
     swt, energy): every stage in its folder, DFDI skipped on the elastic half-space with the

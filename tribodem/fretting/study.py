@@ -106,6 +106,10 @@ def row_of(st: Stage, summary: dict[str, Any]) -> dict[str, Any]:
         if key in crit:
             row[key] = crit[key]
     rep = summary.get("first_body_report", {}).get("cycles", [])
+    soft = [c for c in rep if c.get("contact_penalty_scale", 1.0) < 1.0]
+    if soft:  # cycles whose ccx job converged only on a softened contact (it wears less)
+        row["softened_cycles"] = [int(c["cycle"]) for c in soft]
+        row["softest_penalty_scale"] = min(float(c["contact_penalty_scale"]) for c in soft)
     if rep:  # the backend's own peaks (fe: over the integration points of the cycle)
         row["max_von_mises_Pa"] = max(c["max_von_mises_pa"] for c in rep)
         row["max_s22_Pa"] = max(c["max_s22_compressive_pa"] for c in rep)
@@ -177,6 +181,10 @@ def write_markdown(out: Path, rows: list[dict[str, Any]], table: list[dict[str, 
             f"{r['wall_time_s']:.1f} |")
     lines += [f"\n{r['stage']}, cycle-jumping: {r['jump_reading']}." for r in rows
               if r.get("jump_reading")]
+    lines += [f"\n{r['stage']}: cycle(s) {_spans(r['softened_cycles'])} of "
+              f"{r['cycles']} converged only on a softened contact (penalty x "
+              f"{r['softest_penalty_scale']:g} at the softest; a softer contact wears less: "
+              "docs/fe.md `retry_from`)." for r in rows if r.get("softened_cycles")]
     lines += ["", "| stage | quantity | seed | ours | ours / seed | within 20 % (a bound "
               "\"> x\": at least x) |",
               "|---|---|---|---|---|---|"]
@@ -191,6 +199,17 @@ def write_markdown(out: Path, rows: list[dict[str, Any]], table: list[dict[str, 
               f"Seed (section 6.8), largest over-prediction first: {', '.join(SEED_ORDER)}; "
               f"{SEED_CONCLUSION}.", ""]
     return write_text(out / "study.md", "\n".join(lines))
+
+
+def _spans(cycles: list[int]) -> str:
+    """``[1, 2, 3, 5]`` -> ``"1-3, 5"``."""
+    out: list[str] = []
+    for c in sorted(cycles):
+        if out and c == int(out[-1].split("-")[-1]) + 1:
+            out[-1] = f"{out[-1].split('-')[0]}-{c}"
+        else:
+            out.append(str(c))
+    return ", ".join(out)
 
 
 def depth_plot(out: Path, runs_done: dict[str, Path]) -> Path | None:
