@@ -337,9 +337,10 @@ class FEConfig(_Model):
         None, gt=0, description="wall-clock limit of one ccx job, s (left out: the "
         "backend's, fe 1800 s, fe3d 14400 s: the seed's 3D cycle takes ~1 h with Debian's "
         "ccx on 2 threads, ~40 min at h = a/4 with ccx_pardiso)")
-    retries: int = Field(1, ge=0, le=4, description="retries after a non-convergence: "
+    retries: int = Field(1, ge=0, le=6, description="retries after a non-convergence: "
                          "halved increments, then also a contact half as stiff, alternately "
-                         "(jobs.attempt_settings; 1: halved increments only)")
+                         "(jobs.attempt_settings; 1: halved increments only; 5: (8, 1/4), "
+                         "the finest increments at a quarter of the penalty)")
     retry_from: Literal["first", "last"] = Field(
         "first", description="where a cycle's ccx attempts start: first, the job as "
         "configured (every cycle); last, the attempt on which the previous cycle converged "
