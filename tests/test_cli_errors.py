@@ -29,6 +29,7 @@ CONFIGS = {
     "fr_unknown": "[wear]\ncriterium = 'energy'\n",
     "fr_slope": "solver = 'fe3d'\n[fe]\nmax_wear_slope = 0.0\n",
     "fr_retry_from": "solver = 'fe3d'\n[fe]\nretry_from = 'middle'\n",
+    "fr_retries": "solver = 'fe3d'\n[fe]\nretries = 7\n",
     "fr_slope_2d": ("solver = 'fe'\n[contact]\ngeometry = 'cylinder_on_flat'\n"
                     "load_per_length = 1e5\nwindow = 1e-3\n[fe]\nmax_wear_slope = 0.2\n"),
     "br_index": "[condition]\nindex = 9\n",
@@ -135,6 +136,8 @@ CASES: list[tuple[str, list[str], list[str]]] = [
                              NEW], ["fe.max_wear_slope", "0.2", "'fe3d' has it"]),
     ("fretting-retry-from", ["fretting", "run", "--config", "{cfg:fr_retry_from}", "--out",
                              NEW], ["fe.retry_from", "middle", "'first'", "'last'"]),
+    ("fretting-retries-7", ["fretting", "run", "--config", "{cfg:fr_retries}", "--out", NEW],
+     ["fe.retries", "7", "6"]),
     ("fretting-out-file", ["fretting", "run", "--quick", "--out", "{file}"], ["--out"]),
     ("fretting-resume-empty", ["fretting", "run", "--quick", "--out", "{tmp}", "--resume"],
      ["--out"]),
