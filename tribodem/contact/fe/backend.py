@@ -70,13 +70,7 @@ from tribodem.contact.fe.ccx import (
     find_ccx,
 )
 from tribodem.contact.fe.deck import LoadCase, sliding_contact, write_deck
-from tribodem.contact.fe.jobs import (
-    CcxJobs,
-    JobRecord,
-    attempt_index,
-    check_stress_depth,
-    run_job,
-)
+from tribodem.contact.fe.jobs import CcxJobs, JobRecord, check_stress_depth
 from tribodem.contact.fe.mesh import (
     Mesh,
     PadOnFlat,
@@ -486,7 +480,7 @@ class FEContactSolver(CcxJobs, FirstBodySolver):
         lower, upper = self._materials()
         seat = self._seat(mesh)
         t_mesh = time.perf_counter() - t0
-        base = math.ceil(self.plastic_increments / self.n_increments) if self.plastic else 1
+        base = self._cycle_refine()
 
         def write(refine: int, name: str, scale: float) -> Path:
             case = LoadCase(load=self.load_per_length, delta=self.amplitude,
@@ -498,11 +492,7 @@ class FEContactSolver(CcxJobs, FirstBodySolver):
                               self._scaled_settings(scale), fine_stress=False,
                               stress_sets=("LCOL", "UCOL"))
 
-        run, refine, scale, t_deck, t_ccx = run_job(write, self.retries, self.threads,
-                                                    self.timeout, self.executable, self.cache,
-                                                    start=self._first_attempt())
-        self._penalty_scale = scale
-        self._last_attempt = attempt_index(refine, scale)
+        run, refine, scale, t_deck, t_ccx = self._run_attempts(write)
         t_mesh += t_deck
         t3 = time.perf_counter()
         res = read_results(run.job, mesh)
@@ -933,5 +923,9 @@ class FEContactSolver(CcxJobs, FirstBodySolver):
         self.cycle_reports = list(state.get("cycle_reports", []))
         if self.workdir is None and state.get("workdir"):
             self.workdir = Path(state["workdir"])
-        self._restore_last_attempt(
-            state, math.ceil(self.plastic_increments / self.n_increments) if self.plastic else 1)
+        self._restore_last_attempt(state, self._cycle_refine())
+
+    def _cycle_refine(self) -> int:
+        """ccx increments per output increment of a cycle (plastic: at least
+        ``plastic_increments`` per cycle); ``jobs.csv``'s refine is an attempt's times it."""
+        return math.ceil(self.plastic_increments / self.n_increments) if self.plastic else 1

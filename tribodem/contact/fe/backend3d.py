@@ -103,13 +103,7 @@ from tribodem.contact.fe.deck import (
     _write_ids,
     sliding_contact,
 )
-from tribodem.contact.fe.jobs import (
-    CcxJobs,
-    JobRecord,
-    attempt_index,
-    check_stress_depth,
-    run_job,
-)
+from tribodem.contact.fe.jobs import CcxJobs, JobRecord, check_stress_depth
 from tribodem.contact.fe.mesh import surface_projection, worn_depth
 from tribodem.contact.fe.results import DatBlock, read_dat
 from tribodem.contact.fe.slope import SlopeLimit, limit_slope, steepest
@@ -851,18 +845,14 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         seat = self._seat(mesh)
         t_mesh = time.perf_counter() - t0
         try:
-            run, refine, scale, t_deck, t_ccx = run_job(
+            run, refine, scale, t_deck, t_ccx = self._run_attempts(
                 lambda refine, name, scale: self.write_deck(folder / f"{name}.inp", mesh,
-                                                            seat, refine, scale),
-                self.retries, self.threads, self.timeout, self.executable, self.cache,
-                start=self._first_attempt())
+                                                            seat, refine, scale))
         except CcxConvergenceError as err:
             hint = self._steepness_hint()
             if hint:
                 raise FESolverStopped(f"{err}\n{hint}") from None
             raise
-        self._penalty_scale = scale
-        self._last_attempt = attempt_index(refine, scale)
         t_mesh += t_deck
         t3 = time.perf_counter()
         blocks = read_dat(run.dat)

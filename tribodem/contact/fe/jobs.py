@@ -267,9 +267,11 @@ class CcxJobs:
     _pending: list[PlasticStep]
     settings: ContactSettings  #: the interface law as configured
     mesh: Any  #: the (morphed) mesh of the last job (``h_fine``, m)
-    #: the contact penalty scale of the last job's converged attempt (:func:`attempt_settings`)
-    _penalty_scale: float = 1.0
     retries: int
+    threads: int
+    timeout: float
+    executable: str | None
+    cache: Path | None
     #: where a job's attempts start (:data:`RETRY_FROM`)
     retry_from: str = "first"
     #: the attempt on which the last job converged (:func:`attempt_index`; kept in the
@@ -286,6 +288,20 @@ class CcxJobs:
     def _first_attempt(self) -> int:
         """The attempt the next job starts at (:data:`RETRY_FROM`)."""
         return min(self._last_attempt, self.retries) if self.retry_from == "last" else 0
+
+    @property
+    def _penalty_scale(self) -> float:
+        """The contact penalty scale of the last job's converged attempt."""
+        return attempt_settings(self._last_attempt)[1]
+
+    def _run_attempts(self, write: Callable[[int, str, float], Path]
+                      ) -> tuple[CcxRun, int, float, float, float]:
+        """:func:`run_job` with this backend's ccx settings, from :meth:`_first_attempt`;
+        keeps the attempt that converged (``_last_attempt``)."""
+        out = run_job(write, self.retries, self.threads, self.timeout, self.executable,
+                      self.cache, start=self._first_attempt())
+        self._last_attempt = attempt_index(out[1], out[2])
+        return out
 
     def _attempt_report(self) -> dict[str, Any]:
         """The last job's converged attempt, for its cycles' reports (summary.json): its
