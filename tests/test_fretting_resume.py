@@ -379,8 +379,8 @@ def test_a_checkpoint_from_before_config_version_2_resumes(tmp_path: Path) -> No
     [fe] out; the resumed run records the marker and the fields left out. Old study.toml
     files and a sweep member's old summary.json are read the same way."""
     from tribodem.fretting.cli import _jsonable, recorded_config
-    from tribodem.fretting.debris_study import study_diffs
     from tribodem.fretting.output import CHECKPOINT, read_checkpoint, write_checkpoint
+    from tribodem.fretting.record import study_diffs
     from tribodem.fretting.sweep import member_plan
     from tribodem.io.config import dump_toml
 
@@ -416,7 +416,7 @@ def test_a_study_resumes_with_other_threads_or_retries_and_names_what_may_not_ch
     a field that makes another run is refused by name with both values, and so is
     ``--quick``."""
     from tribodem.fretting.cli import _jsonable
-    from tribodem.fretting.debris_study import study_diffs
+    from tribodem.fretting.record import study_diffs
     from tribodem.io.config import dump_toml
 
     cfg = resolve_config(None, overrides={"solver": "fe3d", "fe": {"threads": 2}})

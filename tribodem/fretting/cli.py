@@ -1210,7 +1210,7 @@ def study_cmd(
     """Seed 003 chapter 6: every material evolution criterion on one case (one cycle for
     von Mises, S22, DFDI, SWT; 30 for shear and energy; shear with jumping to 110), the
     seed's numbers beside ours and the criteria ordered (study.md, study.json)."""
-    from tribodem.fretting.debris_study import read_study
+    from tribodem.fretting.record import read_study
     from tribodem.fretting.study import run_study
 
     runs.check_out_dir(out, "--out", resume=resume, need=("study.toml",) if resume else ())
@@ -1251,7 +1251,8 @@ def debris_study_cmd(
     debris particles (figs 5.22-5.27); writes debris_study.{csv,json}, plots, per-count data."""
     import numba
 
-    from tribodem.fretting.debris_study import SEED_COUNTS, read_study, run_debris_study
+    from tribodem.fretting.debris_study import SEED_COUNTS, run_debris_study
+    from tribodem.fretting.record import read_study
 
     n_threads = runs.check_threads(threads, "--threads")
     runs.check_out_dir(out, "--out", resume=resume, need=("study.toml",) if resume else ())

@@ -277,7 +277,7 @@ def run_study(cfg: Any, out: Path, quick: bool = False, resume: bool = False,
     meta = {"config": _jsonable(cfg), "quick": bool(quick)}
     if resume:
         from tribodem.fretting.cli import resume_allowed
-        from tribodem.fretting.debris_study import study_diffs
+        from tribodem.fretting.record import study_diffs
 
         diffs = study_diffs(out, meta)
         if diffs:
