@@ -23,6 +23,7 @@ command-line run) and skip without ccx.
 
 from __future__ import annotations
 
+import hashlib
 import json
 import math
 import os
@@ -624,10 +625,8 @@ def test_a_failure_record_names_the_build_not_the_file(tmp_path: Path) -> None:
         (tmp_path / name).mkdir()
         copies.append(str(shutil.copy2(exe, tmp_path / name / "ccx")))
         os.utime(copies[-1], ns=(10**18 + k, 10**18 + k))
-    deck = tmp_path / "job.inp"
-    deck.write_text("*HEADING\nsame deck\n")
+    deck = hashlib.sha256(b"*HEADING\nsame deck\n")
     assert jobs._failure_key(deck, copies[0]) == jobs._failure_key(deck, copies[1])
     assert jobs._cache_key(deck, copies[0]) != jobs._cache_key(deck, copies[1])
-    other = tmp_path / "other.inp"
-    other.write_text("*HEADING\nanother deck\n")
+    other = hashlib.sha256(b"*HEADING\nanother deck\n")
     assert jobs._failure_key(other, copies[0]) != jobs._failure_key(deck, copies[0])

@@ -86,10 +86,10 @@ MATERIALS = ("elastic", "elastic-plastic")
 CACHED_SUFFIXES = (".dat", ".frd", ".sta", ".cvg", ".log")
 
 
-def _cache_key(deck: Path, executable: str | None) -> str:
-    """The deck's bytes and the ccx executable (path, size, mtime): equal keys, equal
-    results (ccx is deterministic for a given deck and build)."""
-    h = hashlib.sha256(deck.read_bytes())
+def _cache_key(deck_hash: Any, executable: str | None) -> str:
+    """The deck's bytes (``deck_hash``, their sha256) and the ccx executable (path, size,
+    mtime): equal keys, equal results (ccx is deterministic for a given deck and build)."""
+    h = deck_hash.copy()
     exe = resolve_ccx(executable)
     if exe:
         st = Path(exe).stat()
@@ -131,12 +131,13 @@ def _to_cache(run: CcxRun, cache: Path, key: str) -> None:
 FAILED_SUFFIX = ".failed"
 
 
-def _failure_key(deck: Path, executable: str | None) -> str:
-    """The deck's bytes and the ccx build by what it is (version line, solvers, patches:
-    :func:`~tribodem.contact.fe.ccx.ccx_build`), not by its file as ``_cache_key``: a
-    record carried to another machine (``tools/carry_run``), whose ``tools/build_ccx_pardiso``
-    made the same build anew, still skips the attempt that failed."""
-    h = hashlib.sha256(deck.read_bytes())
+def _failure_key(deck_hash: Any, executable: str | None) -> str:
+    """The deck's bytes (``deck_hash``) and the ccx build by what it is (version line,
+    solvers, patches: :func:`~tribodem.contact.fe.ccx.ccx_build`), not by its file as
+    ``_cache_key``: a record carried to another machine (``tools/carry_run``), whose
+    ``tools/build_ccx_pardiso`` made the same build anew, still skips the attempt that
+    failed."""
+    h = deck_hash.copy()
     exe = resolve_ccx(executable)
     if exe:
         b = ccx_build(exe)
@@ -203,12 +204,13 @@ def run_job(write: Callable[[int, str, float], Path], retries: int, threads: int
         t1 = time.perf_counter()
         deck = write(refine, name, scale)
         t_deck += time.perf_counter() - t1
-        key = _cache_key(deck, executable)
+        deck_hash = hashlib.sha256(deck.read_bytes())  # read and hashed once for both keys
+        key = _cache_key(deck_hash, executable)
         if cache is not None:
             hit = _from_cache(deck, cache, key)
             if hit is not None:
                 return hit, refine, scale, t_deck, t_ccx
-        fkey = _failure_key(deck, executable)
+        fkey = _failure_key(deck_hash, executable)
         known = _known_failure(deck, fkey)
         if known is not None:  # this very deck failed here before: the next attempt
             if attempt == retries:
