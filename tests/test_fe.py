@@ -114,10 +114,41 @@ def test_deck_plastic_table_and_steps(tmp_path: Path) -> None:
     text = deck.read_text()
     assert text.count("*STEP") == 3 and text.count("*PLASTIC") == 2
     e_pl = 0.132 - 1000e6 / 240e9
-    assert f"{1000e6:.9e}, {e_pl:.9e}" in text
+    h = (1000e6 - 680e6) / e_pl  # the line through the yield and the UTS, past the UTS
+    assert f"{680e6 + h:.9e}, {1.0:.9e}" in text
+    held = FEMaterial(yield_strength=680e6, beyond_uts="hold")
+    text = write_deck(tmp_path / "held.inp", mesh, LoadCase(load=1e5, delta=3e-6), held,
+                      held).read_text()
+    assert f"{1000e6:.9e}, {e_pl:.9e}" in text and f"{1.0:.9e}" not in text
     assert "TYPE=SURFACE TO SURFACE" in text and "*CHANGE FRICTION" in text
     with pytest.raises(ValueError, match="multiple of 4"):
         write_deck(tmp_path / "bad.inp", mesh, LoadCase(delta=1e-6, n_increments=6))
+
+
+def test_one_plastic_law_for_every_backend() -> None:
+    """The ccx table of the bilinear EN24T law (seed table 5.1) is tamaas's: the line
+    sigma = Y + h eps_p with h = bilinear_hardening (2.50 GPa; E_t from (Y / E, Y) to
+    (0.132, UTS)), to round-off, through (UTS, 0.132 - UTS / E); "hold" stops it at the
+    UTS; a given ``hardening`` is the same line, held at the UTS where the line meets it."""
+    from tribodem.contact import bilinear_hardening
+
+    y, u, e = 680e6, 1000e6, 240e9
+    h = bilinear_hardening(e, y, u, 0.132)
+    (y0, p0), (s1, p1) = FEMaterial(yield_strength=y).plastic_table()
+    assert (y0, p0) == (y, 0.0) and p1 == 1.0
+    assert (s1 - y0) / p1 == pytest.approx(h, rel=1e-12)
+    p_uts = 0.132 - u / e
+    assert y0 + (s1 - y0) * p_uts == pytest.approx(u, rel=1e-12)
+    assert FEMaterial(yield_strength=y, beyond_uts="hold").plastic_table() == [
+        (y, 0.0), (u, p_uts)]
+    assert FEMaterial(yield_strength=y, hardening=h).plastic_table() == [(y, 0.0), (y + h, 1.0)]
+    (_, _), (s2, p2) = FEMaterial(yield_strength=y, hardening=h,
+                                  beyond_uts="hold").plastic_table()
+    assert s2 == u and p2 == pytest.approx(p_uts, rel=1e-12)
+    assert FEMaterial(yield_strength=y, hardening=0.0, beyond_uts="hold").plastic_table() == [
+        (y, 0.0)]
+    with pytest.raises(ValueError, match="beyond_uts = 'cap' is not allowed"):
+        FEMaterial(yield_strength=y, beyond_uts="cap").plastic_table()
 
 
 def test_read_dat_blocks(tmp_path: Path) -> None:

@@ -351,24 +351,71 @@ def test_a_recorded_config_from_before_config_version_2_reads_the_old_defaults_a
             check_resume(cfg, {"config": _before_v2(left_out)}, ck)
 
 
+def test_a_version_2_record_keeps_the_flow_stress_its_ccx_bodies_ran_with(
+        tmp_path: Path) -> None:
+    """Before config_version 3 the ccx backends held the flow stress at the UTS (their
+    *PLASTIC table's last row) unless [plastic] hardening was given; tamaas's line went on.
+    A version-2 record reads as what ran: fe3d elastic-plastic -> beyond_uts 'hold', with a
+    hardening given, elastic bodies or tamaas -> 'line'. Its resume from a config that
+    leaves beyond_uts out (now 'line') is refused naming the field; a run's version-2
+    config.toml given back with --config runs 'hold' as it did."""
+    from tribodem.fretting.cli import (
+        CONFIG_VERSION,
+        FrettingConfig,
+        check_resume,
+        recorded_config,
+    )
+    from tribodem.io.config import ConfigError, dump_toml
+
+    def v2(cfg: FrettingConfig) -> dict:
+        old = json.loads(json.dumps(cfg.model_dump()))
+        del old["plastic"]["beyond_uts"]
+        return old | {"config_version": 2}
+
+    ep = FrettingConfig(solver="fe3d", fe={"material": "elastic-plastic"})
+    read = recorded_config(v2(ep))
+    assert read["config_version"] == CONFIG_VERSION
+    assert read["plastic"]["beyond_uts"] == "hold"
+    for cfg in (FrettingConfig(solver="fe3d", fe={"material": "elastic-plastic"},
+                               plastic={"hardening": 2.5e9}),
+                FrettingConfig(solver="fe3d"), FrettingConfig(solver="elastic-plastic")):
+        assert recorded_config(v2(cfg))["plastic"]["beyond_uts"] == "line"
+        check_resume(cfg, {"config": v2(cfg)}, Path("ck.npz"))
+    with pytest.raises(ConfigError, match=r"plastic\.beyond_uts = 'line' \(checkpoint: "
+                                          r"'hold'\)"):
+        check_resume(ep, {"config": v2(ep)}, Path("ck.npz"))
+    held = ep.model_copy(update={"plastic": ep.plastic.model_copy(
+        update={"beyond_uts": "hold"})})
+    check_resume(held, {"config": v2(ep)}, Path("ck.npz"))
+    given_back = tmp_path / "config.toml"
+    given_back.write_text(dump_toml(v2(ep)))
+    assert resolve_config(given_back) == held
+
+
 def test_a_new_config_round_trips_with_its_marker(tmp_path: Path) -> None:
     """What tribodem writes carries config_version: config.toml (the [fe] fields left out
     stay out and reload as left out) and a checkpoint (read back unchanged, None stays
     None, so a resume makes the same run)."""
-    from tribodem.fretting.cli import FrettingConfig, check_resume, recorded_config
+    from tribodem.fretting.cli import (
+        CONFIG_VERSION,
+        FrettingConfig,
+        check_resume,
+        recorded_config,
+    )
     from tribodem.fretting.output import read_checkpoint, write_checkpoint
     from tribodem.io.config import dump_toml
 
     cfg = FrettingConfig(solver="fe3d")
     text = dump_toml(cfg.model_dump())
-    assert "config_version = 2" in text and "h_over_a" not in text
+    assert f"config_version = {CONFIG_VERSION}" in text and "h_over_a" not in text
     path = tmp_path / "config.toml"
     path.write_text(text)
     assert resolve_config(path) == cfg
     write_checkpoint(tmp_path / "checkpoint.npz", {"config": json.loads(json.dumps(
         cfg.model_dump())), "cycles_done": 1}, {})
     meta, _ = read_checkpoint(tmp_path / "checkpoint.npz")
-    assert meta["config"]["config_version"] == 2 and meta["config"]["fe"]["h_over_a"] is None
+    assert meta["config"]["config_version"] == CONFIG_VERSION
+    assert meta["config"]["fe"]["h_over_a"] is None
     assert resolve_config(None, base=recorded_config(meta["config"])) == cfg
     check_resume(cfg, meta, tmp_path / "checkpoint.npz")
 

@@ -126,7 +126,8 @@ class ElastoPlasticSolver(HalfSpaceSolver):
     ``uts_strain``), ``ep_n`` coarse points per side (32), ``ep_nz`` layers (12),
     ``ep_window_radii`` (5) and ``ep_depth_radii`` (2) Hertz radii, ``load_steps`` (4),
     ``ep_tolerance`` (EPIC fixed point, 1e-6), ``ep_max_iter`` (300), ``reload_cycles``
-    (False). Both bodies must be of the same material.
+    (False), ``beyond_uts`` (only ``"line"``: the hardening line goes on past the UTS).
+    Both bodies must be of the same material.
     """
 
     capabilities = Capabilities(plastic=True, partial_slip=True, subsurface=True, debris=True,
@@ -139,6 +140,7 @@ class ElastoPlasticSolver(HalfSpaceSolver):
         *,
         yield_strength: float = YIELD_EN24T,
         hardening: float | None = None,
+        beyond_uts: str = "line",
         uts: float = UTS_EN24T,
         uts_strain: float = UTS_STRAIN_EN24T,
         ep_n: int = 32,
@@ -158,6 +160,10 @@ class ElastoPlasticSolver(HalfSpaceSolver):
                 "upper_material and lower_material differ: the elastic-plastic solver needs "
                 "both bodies of the same material (same traction -> same plastic state)"
             )
+        if beyond_uts != "line":
+            raise ValueError(f"beyond_uts = {beyond_uts!r} is not allowed: tamaas's linear "
+                             "hardening goes on past the UTS; allowed: 'line' (or a ccx "
+                             "solver, fe or fe3d, for 'hold')")
         mat = self.upper_material
         self.yield_strength = _check_positive("yield_strength", yield_strength)
         if hardening is None:

@@ -253,13 +253,19 @@ class WearConfig(_Model):
 
 
 class PlasticConfig(_Model):
-    """``solver = "elastic-plastic"``: tamaas EPIC, bilinear EN24T (seed table 5.1)."""
+    """The plastic law of ``solver = "elastic-plastic"`` (tamaas EPIC; its ``ep_*`` grid) and
+    of the ccx backends' ``[fe] material = "elastic-plastic"``: bilinear EN24T (seed table
+    5.1), one law for every backend."""
 
     yield_strength: float = Field(EN24T.yield_strength, gt=0, description="initial yield, Pa")
     uts: float = Field(EN24T.uts, gt=0, description="ultimate tensile strength, Pa")
     uts_strain: float = Field(EN24T.uts_strain, gt=0, lt=1,
                               description="engineering strain at UTS")
     hardening: float | None = Field(None, ge=0, description="h, Pa (None: bilinear)")
+    beyond_uts: Literal["line", "hold"] = Field(
+        "line", description="past the UTS: line, the hardening line goes on (seed fig. 5.5; "
+        "tamaas's law, the only one it has); hold, the flow stress stays at the UTS (fe, "
+        "fe3d; their law before config_version 3)")
     ep_n: int = Field(32, ge=8, le=256, description="EP grid points per side (even)")
     ep_nz: int = Field(12, ge=3, le=64, description="EP grid layers")
     ep_window_radii: float = Field(5.0, gt=0, description="EP window, Hertz radii")
@@ -375,10 +381,11 @@ class FEConfig(_Model):
 #: Layout version of the fretting config, recorded as ``config_version`` in every config
 #: tribodem writes (config.toml, summary.json, checkpoint.npz, study.toml). 2: ``[fe]
 #: h_over_a`` / ``size_factor`` left out are the backend's own (:data:`FE_BACKEND_OWN`); a
-#: recorded config without it is older (:func:`recorded_config`). A version 3 must let the
-#: field take 2 as well and have :func:`recorded_config` migrate a version-2 record (users
-#: give runs' config.toml back with --config, and old checkpoints resume).
-CONFIG_VERSION = 2
+#: recorded config without it is older. 3: ``[plastic] beyond_uts`` (default "line": the
+#: ccx backends held the flow stress at the UTS before). :func:`recorded_config` migrates an
+#: older record, and a config file that names an older version (a run's config.toml given
+#: back with --config) is read the same way (:func:`resolve_config`).
+CONFIG_VERSION = 3
 
 
 class FrettingConfig(_Model):
@@ -800,6 +807,11 @@ def build_solver(cfg: FrettingConfig) -> FirstBodySolver:
         lower_material=lo, n=c.n, window=window, regime=c.regime, tolerance=c.tolerance)
     if backend.capabilities.plastic:
         kw |= cfg.plastic.model_dump()
+        if cfg.plastic.beyond_uts != "line" and backend not in ccx_backends():
+            raise ConfigError(
+                f"plastic.beyond_uts = {cfg.plastic.beyond_uts!r}: solver = {cfg.solver!r} "
+                "has linear hardening only (it goes on past the UTS); allowed: 'line', or "
+                "solver = 'fe' or 'fe3d' with [fe] material = 'elastic-plastic'")
     if "line" in backend.capabilities.contacts and not isinstance(geo, HeightMaps):
         kw["contact"] = geo.contact
     if backend in ccx_backends():
@@ -883,6 +895,8 @@ def resolve_config(config: Path | None, quick: bool = False,
                 v = contact.get(key)
                 if isinstance(v, str) and not Path(v).expanduser().is_absolute():
                     contact[key] = str(Path(config).parent / v)
+        if data.get("config_version", CONFIG_VERSION) != CONFIG_VERSION:
+            data = recorded_config(data)  # a run's record given back: what it ran
     else:
         data, source = dict(base or {}), "command line"
     if quick:
@@ -917,22 +931,33 @@ FE_DEFAULTS_BEFORE_V2: dict[str, float] = {"h_over_a": 0.25, "size_factor": 40.0
 
 def recorded_config(data: dict[str, Any]) -> dict[str, Any]:
     """A config that tribodem recorded (a checkpoint's, study.toml's, a run folder's
-    summary.json or config.toml) as this version reads it; a user's config file is never
-    read through this: it means what it says.
+    summary.json or config.toml) as this version reads it; a user's config file goes
+    through this only when it names an older ``config_version`` (:func:`resolve_config`):
+    else it means what it says. A version this one does not know is returned as it is
+    (validation refuses it).
 
     Without ``config_version`` it was written before version 2, when every config held
     ``[fe] h_over_a = 0.25`` and ``size_factor = 40.0`` unless they were set otherwise and
     fe3d read these values as "its own" (h = a/3, bodies 8 a): they become None, left out,
-    the backend's own (for fe the same 0.25 and 40), and the version is added.
+    the backend's own (for fe the same 0.25 and 40). Before version 3 the ccx backends (fe,
+    fe3d) held the flow stress of elastic-plastic bodies at the UTS unless ``[plastic]
+    hardening`` was given (then the line went on, as in tamaas): ``beyond_uts`` is set to
+    what ran ("hold" there, else "line").
     """
-    if "config_version" in data:
+    version = data.get("config_version", 1)
+    if version == CONFIG_VERSION or version not in (1, 2):
         return data
-    fe = data.get("fe")
-    if isinstance(fe, dict):
+    if version == 1 and isinstance(data.get("fe"), dict):
         old = FE_DEFAULTS_BEFORE_V2
         data = {**data, "fe": {k: None if k in old and v == old[k] else v
-                               for k, v in fe.items()}}
-    return {**data, "config_version": CONFIG_VERSION}
+                               for k, v in data["fe"].items()}}
+    plastic = data.get("plastic")
+    plastic = dict(plastic) if isinstance(plastic, dict) else {}
+    fe = data.get("fe") if isinstance(data.get("fe"), dict) else {}
+    held = (BACKENDS.get(str(data.get("solver", "elastic"))) in ccx_backends()
+            and fe.get("material") == "elastic-plastic" and plastic.get("hardening") is None)
+    plastic["beyond_uts"] = "hold" if held else "line"
+    return {**data, "plastic": plastic, "config_version": CONFIG_VERSION}
 
 
 def effective_config(data: dict[str, Any]) -> dict[str, Any]:

@@ -161,8 +161,9 @@ class FEContactSolver(CcxJobs, FirstBodySolver):
 
     ``material``: ``"elastic"`` or ``"elastic-plastic"`` (both bodies bilinear isotropic
     hardening, ``*PLASTIC``: ``yield_strength``, ``uts``, ``uts_strain`` (Pa, Pa, -) of seed
-    table 5.1, or a plastic modulus ``hardening`` h in Pa; the tamaas EPIC grid options
-    ``ep_*``, ``load_steps`` are accepted and not used: the mesh is the grid). Plastic jobs
+    table 5.1, or a plastic modulus ``hardening`` h in Pa; past the UTS ``beyond_uts``:
+    ``"line"``, the same line (the tamaas backend's law), or ``"hold"``; the tamaas EPIC grid
+    options ``ep_*``, ``load_steps`` are accepted and not used: the mesh is the grid). Plastic jobs
     take >= ``plastic_increments`` (32) ccx increments per cycle and 10 load increments
     (docs/fe.md).
 
@@ -221,6 +222,7 @@ class FEContactSolver(CcxJobs, FirstBodySolver):
         uts: float = EN24T.uts,
         uts_strain: float = EN24T.uts_strain,
         hardening: float | None = None,
+        beyond_uts: str = "line",
         h_over_a: float = FRETTING_H_OVER_A,
         size_factor: float = 40.0,
         threads: int = 1,
@@ -257,7 +259,7 @@ class FEContactSolver(CcxJobs, FirstBodySolver):
         self.mode = mode
         self.chain_cycles = int(chain_cycles)
         self._set_material(material, plastic_increments, yield_strength, uts, uts_strain,
-                           hardening)
+                           hardening, beyond_uts)
         self.capabilities = self.capabilities_for({"material": material, "mode": mode})
         self.executable = find_ccx(executable)  # CcxNotFoundError names the install command
         self.upper, self.lower = upper, lower

@@ -285,7 +285,8 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
     ``workdir``: the jobs' folder (``cycle_0001/`` ...; None: a new temporary folder).
     ``regime`` and ``tolerance`` are the half-space's options and are not used, nor is
     ``chain_cycles`` (mode ``chained`` of the 2D backend); ``material`` is ``"elastic"`` or
-    ``"elastic-plastic"`` (bilinear EN24T by default, fresh cycles).
+    ``"elastic-plastic"`` (bilinear EN24T by default, fresh cycles; ``beyond_uts``: past the
+    UTS the hardening line goes on, ``"line"``, or the flow stress is held, ``"hold"``).
     """
 
     name = "fe3d"
@@ -333,6 +334,7 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         uts: float = EN24T.uts,
         uts_strain: float = EN24T.uts_strain,
         hardening: float | None = None,
+        beyond_uts: str = "line",
         h_over_a: float = FRETTING3D_H_OVER_A,
         size_factor: float = FRETTING3D_SIZE_FACTOR,
         growth: float = FRETTING3D_GROWTH,
@@ -367,7 +369,7 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
             raise ValueError(f"mode = {mode!r} is not allowed for the fe3d backend: allowed: "
                              f"{', '.join(MODES)}")
         self._set_material(material, plastic_increments, yield_strength, uts, uts_strain,
-                           hardening)
+                           hardening, beyond_uts)
         self.capabilities = self.capabilities_for({"material": material})
         self.mode = mode
         self.executable = find_ccx(executable)

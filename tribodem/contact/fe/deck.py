@@ -5,8 +5,10 @@ Model (SI units; per unit length: the plane-strain thickness is 1 m, so forces a
 * elements ``CPE4`` (ccx expands them to one layer of 8-node bricks);
 * materials: ``*ELASTIC`` (E, nu) and optionally ``*PLASTIC`` with bilinear isotropic
   hardening (seed table 5.1): the true stress grows linearly from the yield stress at zero
-  plastic strain to the UTS at the plastic strain ``uts_strain - UTS / E``, i.e. the tangent
-  modulus E_t = (UTS - Y) / (uts_strain - Y / E) of :func:`bilinear_hardening`;
+  plastic strain through the UTS at the plastic strain ``uts_strain - UTS / E``, i.e. the
+  tangent modulus E_t = (UTS - Y) / (uts_strain - Y / E) of :func:`bilinear_hardening`, and
+  on along the same line (``beyond_uts = "line"``, the tamaas backend's law) or held at the
+  UTS (``"hold"``, the law of config_version 2 and earlier);
 * contact: ``*CONTACT PAIR, TYPE=SURFACE TO SURFACE``, slave the pad's arc, master the flat;
   ``*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR`` with the penalty stiffness
   ``penalty_factor * E / h_fine`` (Pa/m), ``*FRICTION`` mu with the stick slope
@@ -46,6 +48,8 @@ from tribodem.contact.fe.mesh import Mesh
 
 #: engineering strain at the UTS of EN24T used by the tamaas elasto-plastic backend
 UTS_STRAIN_EN24T = 0.132
+#: what the flow stress does past the UTS (:attr:`FEMaterial.beyond_uts`)
+BEYOND_UTS = ("line", "hold")
 
 
 @dataclass(frozen=True)
@@ -60,24 +64,42 @@ class FEMaterial:
     uts_strain: float = UTS_STRAIN_EN24T  #: total strain at the UTS, -
     #: plastic modulus h = d sigma / d eps_p, Pa (None: the bilinear law through the UTS)
     hardening: float | None = None
+    #: past the UTS: "line" (the hardening line goes on; the tamaas backend's law) or
+    #: "hold" (the flow stress stays at the UTS: ccx holds a table's last row)
+    beyond_uts: str = "line"
 
     def plastic_table(self) -> list[tuple[float, float]]:
-        """``*PLASTIC`` rows (true stress Pa, equivalent plastic strain): the bilinear law
-        through (Y, 0) and (UTS, uts_strain - UTS / E), or, with ``hardening`` h, the line
-        sigma = Y + h eps_p (rows at eps_p = 0 and 1)."""
+        """``*PLASTIC`` rows (true stress Pa, equivalent plastic strain) of the linear
+        hardening sigma = Y + h eps_p, h the ``hardening`` given or the bilinear law's
+        through (Y, 0) and (UTS, uts_strain - UTS / E) (seed table 5.1, fig. 5.5): with
+        ``beyond_uts`` "line" rows at eps_p = 0 and 1 (ccx holds Y + h past eps_p = 1),
+        with "hold" at eps_p = 0 and where the line meets the UTS (held after it)."""
         if self.yield_strength is None:
             return []
+        if self.beyond_uts not in BEYOND_UTS:
+            raise ValueError(f"beyond_uts = {self.beyond_uts!r} is not allowed: allowed: "
+                             f"{', '.join(repr(b) for b in BEYOND_UTS)}")
         y, u = float(self.yield_strength), float(self.uts)
         if self.hardening is not None:
             h = float(self.hardening)
             if not (y > 0 and h >= 0 and math.isfinite(h)):
                 raise ValueError(f"linear hardening needs Y > 0 and h >= 0; got Y={y!r}, "
                                  f"h={h!r}")
-            return [(y, 0.0), (y + h, 1.0)]
+            if self.beyond_uts == "line":
+                return [(y, 0.0), (y + h, 1.0)]
+            if h == 0.0 and y <= u:
+                return [(y, 0.0)]
+            if not (0 < y < u):
+                raise ValueError(f"beyond_uts = 'hold' needs 0 < yield < uts; got Y={y!r}, "
+                                 f"UTS={u!r}")
+            return [(y, 0.0), (u, (u - y) / h)]
         if not (0 < y < u) or self.uts_strain <= u / self.young:
             raise ValueError(f"bilinear hardening needs 0 < yield < uts and uts_strain > "
                              f"uts / E; got Y={y!r}, UTS={u!r}, uts_strain={self.uts_strain!r}")
-        return [(y, 0.0), (u, self.uts_strain - u / self.young)]
+        p_uts = self.uts_strain - u / self.young
+        if self.beyond_uts == "hold":
+            return [(y, 0.0), (u, p_uts)]
+        return [(y, 0.0), (y + (u - y) / p_uts, 1.0)]
 
 
 @dataclass(frozen=True)

@@ -32,7 +32,7 @@ from tribodem.contact.fe.ccx import (
     resolve_ccx,
     run_ccx,
 )
-from tribodem.contact.fe.deck import ContactSettings, FEMaterial
+from tribodem.contact.fe.deck import BEYOND_UTS, ContactSettings, FEMaterial
 from tribodem.io.results import write_csv, write_text
 
 
@@ -344,10 +344,12 @@ class CcxJobs:
             self.upper_material.young, self.lower_material.young, self.mesh.h_fine)
 
     def _set_material(self, material: str, plastic_increments: int, yield_strength: float,
-                      uts: float, uts_strain: float, hardening: float | None) -> None:
+                      uts: float, uts_strain: float, hardening: float | None,
+                      beyond_uts: str = "line") -> None:
         """Check and keep the bodies' material (:data:`MATERIALS`) and plastic law (Pa, Pa,
-        -, Pa; ``ValueError`` on an impossible one) and the fewest ccx increments per
-        plastic cycle."""
+        -, Pa, and past the UTS :data:`~tribodem.contact.fe.deck.BEYOND_UTS`;
+        ``ValueError`` on an impossible one) and the fewest ccx increments per plastic
+        cycle."""
         if material not in MATERIALS:
             raise ValueError(f"material = {material!r} is not allowed: allowed: "
                              f"{', '.join(MATERIALS)}")
@@ -360,7 +362,10 @@ class CcxJobs:
         self.plastic_law = FEMaterial(
             yield_strength=_check_positive("yield_strength", yield_strength),
             uts=_check_positive("uts", uts), uts_strain=_check_positive("uts_strain", uts_strain),
-            hardening=hardening)
+            hardening=hardening, beyond_uts=beyond_uts)
+        if beyond_uts not in BEYOND_UTS:
+            raise ValueError(f"beyond_uts = {beyond_uts!r} is not allowed: allowed: "
+                             f"{', '.join(repr(b) for b in BEYOND_UTS)}")
         if self.plastic:
             self.plastic_law.plastic_table()  # ValueError on an impossible law
 
@@ -370,7 +375,8 @@ class CcxJobs:
         law = self.plastic_law
         y = law.yield_strength if self.plastic else None
         return tuple(FEMaterial(b.young, b.poisson, yield_strength=y, uts=law.uts,  # type: ignore[return-value]
-                                uts_strain=law.uts_strain, hardening=law.hardening)
+                                uts_strain=law.uts_strain, hardening=law.hardening,
+                                beyond_uts=law.beyond_uts)
                      for b in (lo, up))
 
     def _plastic_grid_x(self, body: str) -> NDArray[np.float64]:
