@@ -148,7 +148,7 @@ def test_one_plastic_law_for_every_backend() -> None:
     assert FEMaterial(yield_strength=y, hardening=0.0, beyond_uts="hold").plastic_table() == [
         (y, 0.0)]
     with pytest.raises(ValueError, match="beyond_uts = 'cap' is not allowed"):
-        FEMaterial(yield_strength=y, beyond_uts="cap").plastic_table()
+        FEMaterial(yield_strength=y, beyond_uts="cap")
 
 
 def test_read_dat_blocks(tmp_path: Path) -> None:

@@ -68,6 +68,11 @@ class FEMaterial:
     #: "hold" (the flow stress stays at the UTS: ccx holds a table's last row)
     beyond_uts: str = "line"
 
+    def __post_init__(self) -> None:
+        if self.beyond_uts not in BEYOND_UTS:
+            raise ValueError(f"beyond_uts = {self.beyond_uts!r} is not allowed: allowed: "
+                             f"{', '.join(repr(b) for b in BEYOND_UTS)}")
+
     def plastic_table(self) -> list[tuple[float, float]]:
         """``*PLASTIC`` rows (true stress Pa, equivalent plastic strain) of the linear
         hardening sigma = Y + h eps_p, h the ``hardening`` given or the bilinear law's
@@ -76,9 +81,6 @@ class FEMaterial:
         with "hold" at eps_p = 0 and where the line meets the UTS (held after it)."""
         if self.yield_strength is None:
             return []
-        if self.beyond_uts not in BEYOND_UTS:
-            raise ValueError(f"beyond_uts = {self.beyond_uts!r} is not allowed: allowed: "
-                             f"{', '.join(repr(b) for b in BEYOND_UTS)}")
         y, u = float(self.yield_strength), float(self.uts)
         if self.hardening is not None:
             h = float(self.hardening)

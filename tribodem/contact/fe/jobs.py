@@ -32,7 +32,7 @@ from tribodem.contact.fe.ccx import (
     resolve_ccx,
     run_ccx,
 )
-from tribodem.contact.fe.deck import BEYOND_UTS, ContactSettings, FEMaterial
+from tribodem.contact.fe.deck import ContactSettings, FEMaterial
 from tribodem.io.results import write_csv, write_text
 
 
@@ -363,9 +363,6 @@ class CcxJobs:
             yield_strength=_check_positive("yield_strength", yield_strength),
             uts=_check_positive("uts", uts), uts_strain=_check_positive("uts_strain", uts_strain),
             hardening=hardening, beyond_uts=beyond_uts)
-        if beyond_uts not in BEYOND_UTS:
-            raise ValueError(f"beyond_uts = {beyond_uts!r} is not allowed: allowed: "
-                             f"{', '.join(repr(b) for b in BEYOND_UTS)}")
         if self.plastic:
             self.plastic_law.plastic_table()  # ValueError on an impossible law
 
