@@ -18,6 +18,7 @@ import numpy as np
 import pytest
 from conftest import run_tribodem
 
+from tribodem.contact import bilinear_hardening
 from tribodem.contact.fe import jobs
 from tribodem.contact.fe.deck import FEMaterial
 from tribodem.materials.en24t import EN24T
@@ -106,8 +107,13 @@ def test_chained_plastic_cycles_accumulate_and_resume(tmp_path: Path) -> None:
         assert jobs.attempt_settings(c["ccx_attempt"]) == (c["attempt_refine"],
                                                            c["contact_penalty_scale"]), c
     law = FEMaterial(yield_strength=EN24T.yield_strength)
-    (y, _), (uts, p_uts) = law.plastic_table()
-    h = (uts - y) / p_uts
+    (y, _), (s1, p1) = law.plastic_table()
+    h = (s1 - y) / p1
+    # the law that ran, stated: table 5.1's line, on past the UTS (the default)
+    assert rep["plastic_law"] == {"yield_strength_pa": y, "hardening_pa": h,
+                                  "beyond_uts": "line", "plastic_table": [[y, 0.0], [s1, p1]]}
+    assert h == pytest.approx(bilinear_hardening(EN24T.young, y, EN24T.uts, EN24T.uts_strain),
+                              rel=1e-12)
     for c in rep["cycles"]:
         p_max = max(c["max_peeq_upper"], c["max_peeq_lower"])
         assert p_max > 0

@@ -880,6 +880,7 @@ class FEContactSolver(CcxJobs, FirstBodySolver):
         |Q| / (mu P) at +A and -A; the ccx attempt its job converged on
         (:meth:`.jobs.CcxJobs._attempt_report`)."""
         return {"backend": "fe", "mode": self.mode, "material": self.material,
+                "plastic_law": self._law_report(),
                 "ccx": ccx_build(self.executable),
                 "chain_cycles": self.chain_cycles if self.mode == "chained" else None,
                 "chain_restarts": self.chain_restarts, "profile": self.profile(),

@@ -1262,6 +1262,7 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         and last quarters and the drop between them, |Q| / (mu P) at +A and -A; the ccx
         attempt the cycle's job converged on (:meth:`.jobs.CcxJobs._attempt_report`)."""
         return {"backend": "fe3d", "mode": self.mode, "material": self.material,
+                "plastic_law": self._law_report(),
                 "ccx": ccx_build(self.executable),
                 "fe3d": {"elements": int(self._mesh0.elements.shape[0]),
                          "h_fine_m": self._mesh0.h_fine, "size_factor": self.size_factor,

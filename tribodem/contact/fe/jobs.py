@@ -366,6 +366,18 @@ class CcxJobs:
         if self.plastic:
             self.plastic_law.plastic_table()  # ValueError on an impossible law
 
+    def _law_report(self) -> dict[str, Any] | None:
+        """For summary.json: the plastic law the jobs ran (None for elastic bodies): Y,
+        the plastic modulus h (Pa), what happens past the UTS and ccx's ``*PLASTIC`` rows
+        (true stress Pa, equivalent plastic strain; held after the last)."""
+        if not self.plastic:
+            return None
+        rows = self.plastic_law.plastic_table()
+        (y, _), (s1, p1) = rows[0], rows[-1]
+        return {"yield_strength_pa": y, "hardening_pa": (s1 - y) / p1 if p1 > 0 else 0.0,
+                "beyond_uts": self.plastic_law.beyond_uts,
+                "plastic_table": [[s, e] for s, e in rows]}
+
     def _materials(self) -> tuple[FEMaterial, FEMaterial]:
         """The (lower, upper) ccx materials: elastic constants, with the plastic law."""
         lo, up = self.lower_material, self.upper_material
