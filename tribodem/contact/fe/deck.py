@@ -87,21 +87,22 @@ class FEMaterial:
             if not (y > 0 and h >= 0 and math.isfinite(h)):
                 raise ValueError(f"linear hardening needs Y > 0 and h >= 0; got Y={y!r}, "
                                  f"h={h!r}")
-            if self.beyond_uts == "line":
-                return [(y, 0.0), (y + h, 1.0)]
-            if h == 0.0 and y <= u:
-                return [(y, 0.0)]
-            if not (0 < y < u):
-                raise ValueError(f"beyond_uts = 'hold' needs 0 < yield < uts; got Y={y!r}, "
-                                 f"UTS={u!r}")
-            return [(y, 0.0), (u, (u - y) / h)]
-        if not (0 < y < u) or self.uts_strain <= u / self.young:
-            raise ValueError(f"bilinear hardening needs 0 < yield < uts and uts_strain > "
-                             f"uts / E; got Y={y!r}, UTS={u!r}, uts_strain={self.uts_strain!r}")
-        p_uts = self.uts_strain - u / self.young
-        if self.beyond_uts == "hold":
-            return [(y, 0.0), (u, p_uts)]
-        return [(y, 0.0), (y + (u - y) / p_uts, 1.0)]
+            p_uts = (u - y) / h if h > 0.0 else math.inf  # where the line meets the UTS
+        else:
+            if not (0 < y < u) or self.uts_strain <= u / self.young:
+                raise ValueError(f"bilinear hardening needs 0 < yield < uts and uts_strain > "
+                                 f"uts / E; got Y={y!r}, UTS={u!r}, "
+                                 f"uts_strain={self.uts_strain!r}")
+            p_uts = self.uts_strain - u / self.young
+            h = (u - y) / p_uts
+        if self.beyond_uts == "line":
+            return [(y, 0.0), (y + h, 1.0)]
+        if h == 0.0 and y <= u:  # perfectly plastic: the UTS is never reached
+            return [(y, 0.0)]
+        if not (0 < y < u):
+            raise ValueError(f"beyond_uts = 'hold' needs 0 < yield < uts; got Y={y!r}, "
+                             f"UTS={u!r}")
+        return [(y, 0.0), (u, p_uts)]
 
 
 @dataclass(frozen=True)

@@ -345,7 +345,7 @@ class CcxJobs:
 
     def _set_material(self, material: str, plastic_increments: int, yield_strength: float,
                       uts: float, uts_strain: float, hardening: float | None,
-                      beyond_uts: str = "line") -> None:
+                      beyond_uts: str) -> None:
         """Check and keep the bodies' material (:data:`MATERIALS`) and plastic law (Pa, Pa,
         -, Pa, and past the UTS :data:`~tribodem.contact.fe.deck.BEYOND_UTS`;
         ``ValueError`` on an impossible one) and the fewest ccx increments per plastic
