@@ -71,9 +71,10 @@ TINY_RUN = "worn_through_diameters = 0.0\n"
 
 
 def before_config_v2(cfg) -> dict:  # noqa: ANN001 - a FrettingConfig
-    """``cfg`` as tribodem recorded it before config_version 2: every field, [fe] h_over_a
-    and size_factor at the then defaults 0.25 / 40.0, no marker."""
+    """``cfg`` as tribodem recorded it before config_version 2: every field of then, [fe]
+    h_over_a and size_factor at the then defaults 0.25 / 40.0, no marker (and none of the
+    fields added since: [plastic] beyond_uts, [fe] loading_friction)."""
     old = cfg.model_dump(mode="json")
-    del old["config_version"]
+    del old["config_version"], old["plastic"]["beyond_uts"], old["fe"]["loading_friction"]
     old["fe"] |= {"h_over_a": 0.25, "size_factor": 40.0}
     return old

@@ -32,6 +32,7 @@ CONFIGS = {
     "fr_retries": "solver = 'fe3d'\n[fe]\nretries = 7\n",
     "fr_hold": "solver = 'elastic-plastic'\n[plastic]\nbeyond_uts = 'hold'\n",
     "fr_past_uts": "[plastic]\nbeyond_uts = 'cap'\n",
+    "fr_loading_mu": "solver = 'fe3d'\n[fe]\nloading_friction = 'half'\n",
     "fr_slope_2d": ("solver = 'fe'\n[contact]\ngeometry = 'cylinder_on_flat'\n"
                     "load_per_length = 1e5\nwindow = 1e-3\n[fe]\nmax_wear_slope = 0.2\n"),
     "br_index": "[condition]\nindex = 9\n",
@@ -144,6 +145,8 @@ CASES: list[tuple[str, list[str], list[str]]] = [
      ["plastic.beyond_uts", "'hold'", "elastic-plastic", "'line'", "'fe3d'"]),
     ("fretting-beyond-uts", ["fretting", "run", "--config", "{cfg:fr_past_uts}", "--out", NEW],
      ["plastic.beyond_uts", "cap", "line", "hold"]),
+    ("fretting-loading-friction", ["fretting", "run", "--config", "{cfg:fr_loading_mu}",
+                                   "--out", NEW], ["fe.loading_friction", "half", "low", "full"]),
     ("fretting-out-file", ["fretting", "run", "--quick", "--out", "{file}"], ["--out"]),
     ("fretting-resume-empty", ["fretting", "run", "--quick", "--out", "{tmp}", "--resume"],
      ["--out"]),

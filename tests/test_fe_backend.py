@@ -492,14 +492,15 @@ def test_a_ccx_job_over_its_time_limit_stops_with_the_setting_named(tmp_path: Pa
     larger limit (``fe.timeout`` may change on resume) finishes the run."""
     env = _ccx_wrapped_in_cycle_2(tmp_path, "sleep 120")
     cfg = tmp_path / "fe.toml"
-    cfg.write_text(CONFIG.replace("[fe]\n", "[fe]\ntimeout = 30\n"))
+    # 10 s: cycle 1's job takes ~1-3 s (h = a/2, 4 increments); the wait is the test's cost
+    cfg.write_text(CONFIG.replace("[fe]\n", "[fe]\ntimeout = 10\n"))
     out = tmp_path / "run"
     r = run_tribodem("fretting", "run", "--config", str(cfg), "--out", str(out),
                      "--no-progress", env=env)
     assert r.returncode == 3, r.stderr
     assert "Traceback" not in r.stderr
-    assert "30 s wall-clock limit" in r.stderr
-    assert "raise fe.timeout (now 30 s)" in r.stderr
+    assert "10 s wall-clock limit" in r.stderr
+    assert "raise fe.timeout (now 10 s)" in r.stderr
     rows = (out / "results.csv").read_text().splitlines()
     assert len(rows) == 2 and rows[1].startswith("1,")
     cfg.write_text(CONFIG)  # the backend's own limit

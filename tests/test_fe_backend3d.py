@@ -157,6 +157,32 @@ def test_deck_fields_fit_ccx(tmp_path: Path) -> None:
             assert 0.0 < minimum < initial <= maximum <= period == 1.0
 
 
+def test_loading_friction_sets_the_seating_and_loading_coefficient(tmp_path: Path) -> None:
+    """``loading_friction``: "low" writes 0.001 for the seating and loading steps and mu from
+    the first quarter; "full" writes mu from the seating on, and nothing else of the deck
+    changes (the stick slopes, the pair, the steps); "auto" (the default) is "full" for
+    elastic-plastic bodies and "low" for elastic ones; the cycle reports say which ran."""
+    decks = {}
+    for value, material, runs in (("low", "elastic", "low"), ("full", "elastic", "full"),
+                                  ("auto", "elastic", "low"),
+                                  ("auto", "elastic-plastic", "full")):
+        solver = _solver(tmp_path / value, loading_friction=value, material=material)
+        assert solver.loading_friction == runs
+        path = solver.write_deck(tmp_path / f"{value}.inp", solver._mesh0, 1e-6)
+        lines = path.read_text().splitlines()
+        decks[value, material] = lines
+        changed = [lines[k + 2].split(",")[0] for k, line in enumerate(lines)
+                   if line == "*CHANGE FRICTION, INTERACTION=SI"]
+        assert changed == (["0.001", "0.6"] if runs == "low" else ["0.6", "0.6"])
+        assert solver._attempt_report()["loading_mu"] == (1e-3 if runs == "low" else 0.6)
+    low, full = decks["low", "elastic"], decks["full", "elastic"]
+    diff = [(a, b) for a, b in zip(low, full, strict=True) if a != b]
+    assert diff == [("0.001, " + diff[0][0].split(", ")[1], "0.6, " + diff[0][0].split(", ")[1])]
+    assert decks["auto", "elastic"] == low
+    with pytest.raises(ValueError, match="loading_friction = 'half' is not allowed"):
+        _solver(tmp_path / "bad", loading_friction="half")
+
+
 def test_quarters_start_at_a_quarter_of_the_mindlin_slip(tmp_path: Path) -> None:
     """Every quarter of a cycle starts at a reversal, where the contact sticks again: its
     first ccx increment slides REVERSAL_SLIDE (1/4) of the Cattaneo-Mindlin gross-slip

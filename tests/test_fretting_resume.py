@@ -332,7 +332,8 @@ def test_a_recorded_config_from_before_config_version_2_reads_the_old_defaults_a
     read = recorded_config(old)
     assert read["config_version"] == CONFIG_VERSION
     assert (read["fe"]["h_over_a"], read["fe"]["size_factor"]) == (None, None)
-    assert resolve_config(None, base=read) == fe3d  # the resume without --config
+    low = fe3d.model_copy(update={"fe": fe3d.fe.model_copy(update={"loading_friction": "low"})})
+    assert resolve_config(None, base=read) == low  # the resume without --config (v4: low)
     check_resume(fe3d, {"config": old}, ck)
     a4 = FrettingConfig(solver="fe3d", fe={"h_over_a": 0.25})
     with pytest.raises(ConfigError, match=r"fe\.h_over_a = 0\.25 \(checkpoint: 0\.333"):
@@ -369,7 +370,7 @@ def test_a_version_2_record_keeps_the_flow_stress_its_ccx_bodies_ran_with(
 
     def v2(cfg: FrettingConfig) -> dict:
         old = json.loads(json.dumps(cfg.model_dump()))
-        del old["plastic"]["beyond_uts"]
+        del old["plastic"]["beyond_uts"], old["fe"]["loading_friction"]
         return old | {"config_version": 2}
 
     ep = FrettingConfig(solver="fe3d", fe={"material": "elastic-plastic"})
@@ -389,7 +390,49 @@ def test_a_version_2_record_keeps_the_flow_stress_its_ccx_bodies_ran_with(
     check_resume(held, {"config": v2(ep)}, Path("ck.npz"))
     given_back = tmp_path / "config.toml"
     given_back.write_text(dump_toml(v2(ep)))
-    assert resolve_config(given_back) == held
+    assert resolve_config(given_back) == held.model_copy(update={"fe": held.fe.model_copy(
+        update={"loading_friction": "low"})})
+
+
+def test_a_version_3_record_keeps_the_low_friction_its_ccx_bodies_were_loaded_with(
+        tmp_path: Path) -> None:
+    """Before config_version 4 the ccx backends seated and loaded the bodies with friction
+    0.001: a version-3 record of fe or fe3d without ``[fe] loading_friction`` reads as
+    'low' (one that names it keeps it); other solvers' records get the default (the field
+    does nothing there, and the record compares equal to this version's). A resume may
+    change it (the cycles after are another run's: each cycle's ``loading_mu`` says which
+    ran); a run's version-3 config.toml given back with --config loads the bodies as it
+    did."""
+    from tribodem.fretting.cli import (
+        CONFIG_VERSION,
+        FrettingConfig,
+        check_resume,
+        recorded_config,
+    )
+    from tribodem.io.config import dump_toml
+
+    def v3(cfg: FrettingConfig, drop: bool = True) -> dict:
+        old = json.loads(json.dumps(cfg.model_dump()))
+        if drop:
+            del old["fe"]["loading_friction"]
+        return old | {"config_version": 3}
+
+    line = {"contact": {"geometry": "cylinder_on_flat", "radius": 4e-3}}
+    for cfg in (FrettingConfig(solver="fe3d"), FrettingConfig.model_validate(
+            {"solver": "fe", **line, "fe": {"material": "elastic-plastic"}})):
+        assert cfg.fe.loading_friction == "auto"  # the default since version 4
+        read = recorded_config(v3(cfg))
+        assert read["config_version"] == CONFIG_VERSION
+        assert read["fe"]["loading_friction"] == "low"
+        check_resume(cfg, {"config": v3(cfg)}, Path("ck.npz"))  # may change on resume
+        assert recorded_config(v3(cfg, drop=False))["fe"]["loading_friction"] == "auto"
+        given_back = tmp_path / "config.toml"
+        given_back.write_text(dump_toml(v3(cfg)))
+        assert resolve_config(given_back).fe.loading_friction == "low"
+    elastic = FrettingConfig(solver="elastic")
+    other = recorded_config(v3(elastic))  # the field does nothing there: the default
+    assert other["fe"]["loading_friction"] == "auto" and other["config_version"] == 4
+    assert resolve_config(None, base=other) == elastic
 
 
 def test_a_new_config_round_trips_with_its_marker(tmp_path: Path) -> None:

@@ -352,6 +352,13 @@ class FEConfig(_Model):
         "configured (every cycle); last, the attempt on which the previous cycle converged "
         "(the attempts before it are not run; a worn geometry that needed a finer or softer "
         "attempt mostly needs it again: docs/fe.md)")
+    loading_friction: Literal["auto", "low", "full"] = Field(
+        "auto", description="friction while seating and loading: low, 0.001 (the "
+        "frictionless normal problem the Hertz and first-yield checks validate; for "
+        "elastically similar bodies friction does not change it); full, the interface's "
+        "[contact] friction from the first touch, as on a rig; auto: full for "
+        "elastic-plastic bodies (worn plastic fe3d geometries got through only with it), "
+        "low for elastic ones (docs/fe3d.md 'Friction while loading')")
     cache: str | None = Field(None, description="folder of finished ccx jobs keyed by the "
                               "deck's bytes and the ccx build: a deck found there is not run "
                               "again (the chapter 6 study shares one across its stages)")
@@ -384,8 +391,10 @@ class FEConfig(_Model):
 #: recorded config without it is older. 3: ``[plastic] beyond_uts`` (default "line": the
 #: ccx backends held the flow stress at the UTS before). :func:`recorded_config` migrates an
 #: older record, and a config file that names an older version (a run's config.toml given
-#: back with --config) is read the same way (:func:`resolve_config`).
-CONFIG_VERSION = 3
+#: back with --config) is read the same way (:func:`resolve_config`). 4: ``[fe]
+#: loading_friction`` (default "auto": elastic-plastic bodies seated and loaded with the
+#: interface's mu; the ccx backends seated and loaded with 0.001 before).
+CONFIG_VERSION = 4
 
 
 class FrettingConfig(_Model):
@@ -942,22 +951,31 @@ def recorded_config(data: dict[str, Any]) -> dict[str, Any]:
     the backend's own (for fe the same 0.25 and 40). Before version 3 the ccx backends (fe,
     fe3d) held the flow stress of elastic-plastic bodies at the UTS unless ``[plastic]
     hardening`` was given (then the line went on, as in tamaas): ``beyond_uts`` is set to
-    what ran ("hold" there, else "line").
+    what ran ("hold" there, else "line"). Before version 4 the ccx backends seated and
+    loaded the bodies with friction 0.001: ``[fe] loading_friction`` is set to "low" in the
+    records of fe and fe3d runs that leave it out (to the default in the others').
     """
     version = data.get("config_version", 1)
-    if version == CONFIG_VERSION or version not in (1, 2):
+    if version == CONFIG_VERSION or version not in (1, 2, 3):
         return data
     if version == 1 and isinstance(data.get("fe"), dict):
         old = FE_DEFAULTS_BEFORE_V2
         data = {**data, "fe": {k: None if k in old and v == old[k] else v
                                for k, v in data["fe"].items()}}
-    plastic = data.get("plastic")
-    plastic = dict(plastic) if isinstance(plastic, dict) else {}
-    fe = data.get("fe") if isinstance(data.get("fe"), dict) else {}
-    held = (BACKENDS.get(str(data.get("solver", "elastic"))) in ccx_backends()
-            and fe.get("material") == "elastic-plastic" and plastic.get("hardening") is None)
-    plastic["beyond_uts"] = "hold" if held else "line"
-    return {**data, "plastic": plastic, "config_version": CONFIG_VERSION}
+    fe = dict(data["fe"]) if isinstance(data.get("fe"), dict) else {}
+    ccx = BACKENDS.get(str(data.get("solver", "elastic"))) in ccx_backends()
+    if version in (1, 2):
+        plastic = data.get("plastic")
+        plastic = dict(plastic) if isinstance(plastic, dict) else {}
+        held = (ccx and fe.get("material") == "elastic-plastic"
+                and plastic.get("hardening") is None)
+        plastic["beyond_uts"] = "hold" if held else "line"
+        data = {**data, "plastic": plastic}
+    # a record that names it (none before version 4 did) keeps it; for other solvers it
+    # does nothing: the default, so that the record compares equal to this version's
+    low = "low" if ccx else FEConfig.model_fields["loading_friction"].default
+    data = {**data, "fe": fe | {"loading_friction": fe.get("loading_friction", low)}}
+    return {**data, "config_version": CONFIG_VERSION}
 
 
 def effective_config(data: dict[str, Any]) -> dict[str, Any]:
@@ -978,11 +996,13 @@ def effective_config(data: dict[str, Any]) -> dict[str, Any]:
 
 #: Config fields a resumed run may change: ``cycles`` (raised, to extend a run), the
 #: ``[output]`` table (what is written, not the numbers), how ccx runs (threads, time limit,
-#: job cache) and, to go on from a stopped finite-element cycle, its retries and the worn
-#: surface's slope limit (the cycles after the resume are then another run's: each cycle's
-#: ``wear_slope_limit`` in summary.json says whether it had one).
+#: job cache) and, to go on from a stopped finite-element cycle, its retries, the worn
+#: surface's slope limit and the friction while loading (the cycles after the resume are
+#: then another run's: each cycle's ``wear_slope_limit`` and ``loading_mu`` in summary.json
+#: say what it ran with).
 RESUME_MAY_CHANGE = ("cycles", "output.", "fe.threads", "fe.timeout", "fe.cache",
-                     "fe.retries", "fe.retry_from", "fe.max_wear_slope")
+                     "fe.retries", "fe.retry_from", "fe.max_wear_slope",
+                     "fe.loading_friction")
 
 
 def resume_diffs(old_cfg: dict[str, Any], new_cfg: dict[str, Any], what: str = "checkpoint",

@@ -229,6 +229,7 @@ class FEContactSolver(CcxJobs, FirstBodySolver):
         timeout: float = 1800.0,
         retries: int = 1,
         retry_from: str = "first",
+        loading_friction: str = "auto",
         cache: str | Path | None = None,
         workdir: str | Path | None = None,
         executable: str | None = None,
@@ -324,6 +325,7 @@ class FEContactSolver(CcxJobs, FirstBodySolver):
                              if stress_depth is not None else
                              max(4.0 * a, 4.5 * math.sqrt(2.0 * a * self.window / math.pi)))
         self.settings = sliding_contact(self.friction, self.hertz[0])
+        self._set_loading_friction(loading_friction)
         self.jobs: list[JobRecord] = []  #: every ccx job run, in order
         self._mesh0 = self._base_mesh()
         self._job_key: tuple[bytes, bytes] | None = None

@@ -342,6 +342,7 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         timeout: float = 14400.0,
         retries: int = 1,
         retry_from: str = "first",
+        loading_friction: str = "auto",
         cache: str | Path | None = None,
         max_wear_slope: float | None = CONVERGED_SLOPE,
         workdir: str | Path | None = None,
@@ -443,6 +444,7 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         #: flip for ever at h = a/2: measured, docs/fe3d.md), stick slope 0.1 x the penalty
         self.settings: ContactSettings = sliding_contact(self.friction, hz.peak_pressure,
                                                          penalty_factor=PENALTY_FACTOR)
+        self._set_loading_friction(loading_friction)
         self.jobs: list[JobRecord] = []  #: every ccx job run, in order
         self._mesh0 = self._base_mesh()
         self._cols = mesh_columns(self._mesh0)

@@ -178,6 +178,15 @@ def attempt_index(refine: int, scale: float) -> int:
 #: mostly needs it in the next, and each failed attempt costs up to a whole job)
 RETRY_FROM = ("first", "last")
 
+#: the friction coefficient while seating and loading (``[fe] loading_friction``): ``low``,
+#: ContactSettings.mu_loading (1e-3: the frictionless normal problem, which for elastically
+#: similar bodies does not depend on friction, as validated); ``full``, the interface's mu
+#: from the first touch, as on a rig; ``auto``, ``full`` for elastic-plastic bodies (not
+#: similar once they yield; worn plastic fe3d geometries got through only with it) and
+#: ``low`` for elastic ones (the worn h = a quick preset stopped with ``full``): docs/fe3d.md
+#: "Friction while loading", measured
+LOADING_FRICTION = ("auto", "low", "full")
+
 
 def run_job(write: Callable[[int, str, float], Path], retries: int, threads: int,
             timeout: float, executable: str | None, cache: Path | None = None,
@@ -276,6 +285,10 @@ class CcxJobs:
     cache: Path | None
     #: where a job's attempts start (:data:`RETRY_FROM`)
     retry_from: str = "first"
+    #: the seating and loading friction that runs, "low" or "full" (:data:`LOADING_FRICTION`)
+    loading_friction: str = "low"
+    plastic: bool
+    friction: float
     #: the attempt on which the last job converged (:func:`attempt_index`; kept in the
     #: backend's state, so a resumed run starts where the uninterrupted one would)
     _last_attempt: int = 0
@@ -286,6 +299,21 @@ class CcxJobs:
             raise ValueError(f"retry_from = {retry_from!r} is not allowed: allowed: "
                              f"{', '.join(RETRY_FROM)}")
         self.retry_from = retry_from
+
+    def _set_loading_friction(self, loading_friction: str) -> None:
+        """Check ``loading_friction`` (:data:`LOADING_FRICTION`) and set the seating and
+        loading friction of ``settings`` from it (call after ``settings``, ``friction`` and
+        the material are set; ``full`` with mu = 0 keeps the low value: ccx refuses a zero
+        coefficient)."""
+        if loading_friction not in LOADING_FRICTION:
+            raise ValueError(f"loading_friction = {loading_friction!r} is not allowed: "
+                             f"allowed: {', '.join(LOADING_FRICTION)}")
+        if loading_friction == "auto":
+            loading_friction = "full" if self.plastic else "low"
+        self.loading_friction = loading_friction
+        if loading_friction == "full":
+            low = ContactSettings.mu_loading
+            self.settings = replace(self.settings, mu_loading=max(self.friction, low))
 
     def _first_attempt(self) -> int:
         """The attempt the next job starts at (:data:`RETRY_FROM`)."""
@@ -311,7 +339,7 @@ class CcxJobs:
         softened contact changes the fields, docs/fe.md ``retry_from``)."""
         refine, scale = attempt_settings(self._last_attempt)
         return {"ccx_attempt": self._last_attempt, "attempt_refine": refine,
-                "contact_penalty_scale": scale}
+                "contact_penalty_scale": scale, "loading_mu": self.settings.mu_loading}
 
     def _restore_last_attempt(self, state: dict[str, Any], refine_unit: int = 1) -> None:
         """``_last_attempt`` from a saved state, else (a state saved before it was kept)
