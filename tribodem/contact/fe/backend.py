@@ -153,7 +153,9 @@ class FEContactSolver(CcxJobs, FirstBodySolver):
     docs/fe.md); ``stress_depth`` (m): how deep the column stresses are printed (None: 4 a
     and 1.5 x the threshold criteria's default depth); ``threads``, ``timeout`` (s per ccx
     job), ``retries`` (after a non-convergence: :func:`.jobs.attempt_settings`, halved
-    increments, then a softer contact);
+    increments, then a softer contact); ``loading_friction``: the friction while seating
+    and loading (:data:`.jobs.LOADING_FRICTION`: ``"auto"``, mu for elastic-plastic
+    bodies and 0.001 for elastic ones);
     ``workdir``: the folder of the jobs (``cycle_0001/`` ...; None: a new temporary
     folder). ``regime`` and ``tolerance``
     are the half-space's options and are not used (the FE interface always has partial slip

@@ -279,7 +279,9 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
     mesh; ``stress_depth`` (m): how deep the column stresses are printed (None: 4.5 a, 1.5 x
     the threshold criteria's default grid depth 3 a); ``threads``, ``timeout`` (s per ccx
     job), ``retries`` (after a non-convergence: :func:`.jobs.attempt_settings`, halved
-    increments, then a softer contact); ``max_wear_slope``: the steepest worn-depth step /
+    increments, then a softer contact); ``loading_friction``: the friction while seating
+    and loading (:data:`.jobs.LOADING_FRICTION`: ``"auto"``, mu for elastic-plastic
+    bodies and 0.001 for elastic ones); ``max_wear_slope``: the steepest worn-depth step /
     column spacing the morphed mesh carries (:func:`.slope.limit_slope`, volume kept; default
     :data:`CONVERGED_SLOPE`; None: the criterion's surface as projected);
     ``workdir``: the jobs' folder (``cycle_0001/`` ...; None: a new temporary folder).
