@@ -312,8 +312,8 @@ class CcxJobs:
             loading_friction = "full" if self.plastic else "low"
         self.loading_friction = loading_friction
         if loading_friction == "full":
-            low = ContactSettings.mu_loading
-            self.settings = replace(self.settings, mu_loading=max(self.friction, low))
+            self.settings = replace(self.settings,
+                                    mu_loading=max(self.friction, self.settings.mu_loading))
 
     def _first_attempt(self) -> int:
         """The attempt the next job starts at (:data:`RETRY_FROM`)."""
