@@ -44,17 +44,19 @@ chain_cycles = 1
 plastic_increments = 16
 h_over_a = 0.5
 size_factor = 15
-[output]
+{cache}[output]
 vtk = false
 figures = false
 """
 
 
 def _config(tmp: Path, name: str = "ep.toml", cycles: int = 2, criterion: str = "dfdi",
-            material: str = "elastic-plastic", mode: str = "chained") -> Path:
+            material: str = "elastic-plastic", mode: str = "chained",
+            cache: Path | None = None) -> Path:
     p = tmp / name
+    line = "" if cache is None else f'cache = "{cache}"\n'
     p.write_text(CONFIG.format(cycles=cycles, criterion=criterion, material=material,
-                               mode=mode))
+                               mode=mode, cache=line))
     return p
 
 
@@ -91,11 +93,14 @@ def test_chained_plastic_cycles_accumulate_and_resume(tmp_path: Path) -> None:
       case measured 0.71-0.79 at h = a/4, docs/fe.md);
     * after each job's last cycle the pad is lifted off: both surfaces keep a residual
       dent and pile-up, each between 0 and 1 um (measured 0.16-0.23 um at h = a/4);
-    * a run stopped after 1 cycle and resumed to 2 gives the same results.csv and
-      criterion.csv (the chain's job is replayed).
+    * a run stopped after 1 cycle and resumed to 2 writes the uninterrupted run's ccx decks
+      byte for byte (the chain's job is replayed: each of its jobs is served from the job
+      cache the uninterrupted run filled, which keys them by the deck's bytes) and gives
+      the same results.csv and criterion.csv.
     """
-    r = run_tribodem("fretting", "run", "--config", str(_config(tmp_path)), "--out",
-                     str(tmp_path / "full"), "--no-progress")
+    cache = tmp_path / "ccx_cache"
+    r = run_tribodem("fretting", "run", "--config", str(_config(tmp_path, cache=cache)),
+                     "--out", str(tmp_path / "full"), "--no-progress")
     assert r.returncode == 0, r.stderr
     summary = json.loads((tmp_path / "full" / "summary.json").read_text())
     rep = summary["first_body_report"]
@@ -131,11 +136,16 @@ def test_chained_plastic_cycles_accumulate_and_resume(tmp_path: Path) -> None:
         assert d[0] > 0 and np.all(np.diff(d) > 0), (body, d)
 
     part = tmp_path / "part"
-    r = run_tribodem("fretting", "run", "--config", str(_config(tmp_path, "p.toml", cycles=1)),
-                     "--out", str(part), "--no-progress")
+    p_toml = _config(tmp_path, "p.toml", cycles=1, cache=cache)
+    r = run_tribodem("fretting", "run", "--config", str(p_toml), "--out", str(part),
+                     "--no-progress")
     assert r.returncode == 0, r.stderr
-    r = run_tribodem("fretting", "run", "--config", str(_config(tmp_path, "p.toml", cycles=1)),
-                     "--out", str(part), "--resume", "--cycles", "2", "--no-progress")
+    r = run_tribodem("fretting", "run", "--config", str(p_toml), "--out", str(part),
+                     "--resume", "--cycles", "2", "--no-progress")
     assert r.returncode == 0, r.stderr
+    ran = [(j["cycle"], j["cached"]) for j in _rows(tmp_path / "full" / "fe" / "jobs.csv")]
+    assert ran == [("1", "0"), ("2", "0")], ran
+    served = [(j["cycle"], j["cached"]) for j in _rows(part / "fe" / "jobs.csv")]
+    assert served == [("1", "1"), ("2", "1")], served
     for name in ("results.csv", "criterion.csv"):
         assert (part / name).read_text() == (tmp_path / "full" / name).read_text(), name
