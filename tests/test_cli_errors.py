@@ -216,3 +216,20 @@ def test_bad_input_exits_2_naming_the_field(tmp_path: Path, name: str, args: lis
     for w in words:
         assert w in text, f"{name}: {w!r} not in the message:\n{text}"
     assert not (tmp_path / "new").exists(), f"{name}: the refused run made its output folder"
+
+
+def test_the_commands_modules_leave_scipys_heavy_subpackages_unimported() -> None:
+    """A refusal (or ``--help``) costs the command's imports: every command's module loads
+    without scipy's signal, optimize, interpolate, spatial, sparse or stats (0.2-0.6 s each
+    to import; the functions that use them import them: 1.4 -> 0.6 s for a refused
+    ``fretting run``, BENCHMARKS.md "Session 38"), checked in a fresh interpreter."""
+    import subprocess
+    import sys
+
+    heavy = ("signal", "optimize", "interpolate", "spatial", "sparse", "stats")
+    code = ("import sys, tribodem.cli as c; c._register(); "
+            f"print(' '.join(m for m in {heavy!r} if 'scipy.' + m in sys.modules))")
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                       timeout=120)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.split() == [], r.stdout

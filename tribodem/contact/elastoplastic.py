@@ -36,13 +36,11 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import tamaas as tm
-import tamaas.nonlinear_solvers  # noqa: F401  (registers tm.nonlinear_solvers)
 from numpy.typing import NDArray
-from scipy.interpolate import RegularGridInterpolator
 
 from tribodem.contact.base import (
     Body,
@@ -60,11 +58,24 @@ from tribodem.contact.halfspace import (
 )
 from tribodem.materials.en24t import EN24T
 
+if TYPE_CHECKING:
+    from scipy.interpolate import RegularGridInterpolator
+
 #: EN24T (seed table 5.1): yield and ultimate tensile strength, Pa.
 YIELD_EN24T = EN24T.yield_strength
 UTS_EN24T = EN24T.uts
 #: Engineering strain at the UTS implied by seed table 6.2 (true 1132 MPa = 1000 (1 + e)).
 UTS_STRAIN_EN24T = EN24T.uts_strain
+
+
+def _grid(points: tuple[NDArray[np.float64], ...], values: NDArray[np.float64],
+          **kw: Any) -> RegularGridInterpolator:
+    """scipy's ``RegularGridInterpolator``, imported on first use: scipy.interpolate (and
+    tamaas.nonlinear_solvers, scipy.optimize) took ~0.7 s to import, which every command
+    paid with this module, an exit-2 usage error as well."""
+    from scipy.interpolate import RegularGridInterpolator
+
+    return RegularGridInterpolator(points, values, **kw)
 
 
 def bilinear_hardening(young: float, yield_strength: float, uts: float, uts_strain: float) -> float:
@@ -228,7 +239,9 @@ class ElastoPlasticSolver(HalfSpaceSolver):
             self._ep, sigma_y=self.yield_strength / self.ep_modulus,
             hardening=self.hardening / self.ep_modulus)
         self._ep_res = tm.Residual(self._ep, self._ep_mat)
-        self._ep_nl = tm.nonlinear_solvers.DFSANECXXSolver(self._ep_res)
+        import tamaas.nonlinear_solvers  # here, not with the module: see _grid
+
+        self._ep_nl = tamaas.nonlinear_solvers.DFSANECXXSolver(self._ep_res)
         # separate model for the Mindlin post-processing: registering or applying volume
         # operators on the EPIC model itself corrupts its next solve (measured: ratcheting)
         self._aux = tm.ModelFactory.createModel(
@@ -289,8 +302,8 @@ class ElastoPlasticSolver(HalfSpaceSolver):
         self._plastic_map = None
         if self.plastic_displacement is not None:
             c = self.ep_coords
-            self._plastic_map = RegularGridInterpolator(
-                (c, c), self.plastic_displacement, bounds_error=False, fill_value=0.0)
+            self._plastic_map = _grid((c, c), self.plastic_displacement,
+                                      bounds_error=False, fill_value=0.0)
 
     def begin_cycle(self) -> None:
         """Elastic-plastic normal solve at offset 0 on the current (worn) surfaces.
@@ -339,8 +352,7 @@ class ElastoPlasticSolver(HalfSpaceSolver):
         border = np.concatenate([up[0], up[-1], up[:, 0], up[:, -1]]).mean()
         up = (up - border) * a
         self.plastic_displacement = up
-        self._plastic_map = RegularGridInterpolator((c, c), up, bounds_error=False,
-                                                    fill_value=0.0)
+        self._plastic_map = _grid((c, c), up, bounds_error=False, fill_value=0.0)
 
     def gap(self, offset: float) -> NDArray[np.float64]:
         """Summed recession plus both bodies' plastic surface displacement, m, [n, n]."""
@@ -381,13 +393,12 @@ class ElastoPlasticSolver(HalfSpaceSolver):
         shift = offset if body == "lower" else 0.0
         zz, xx, yy = np.meshgrid(z, cw + shift, cw, indexing="ij")
         pts = np.stack([zz, xx, yy], -1)
-        cum = RegularGridInterpolator(
+        cum = _grid(
             (self.ep_z, c, c), np.array(self._ep["cumulated_plastic_strain"], dtype=float),
             bounds_error=False, fill_value=0.0)(pts)
         eps = _mandel_to_voigt(self._ep["plastic_strain"])
-        tens = np.stack([RegularGridInterpolator((self.ep_z, c, c), eps[..., k],
-                                                 bounds_error=False, fill_value=0.0)(pts)
-                         for k in range(6)], -1)
+        tens = np.stack([_grid((self.ep_z, c, c), eps[..., k], bounds_error=False,
+                               fill_value=0.0)(pts) for k in range(6)], -1)
         return tens, cum
 
     def subsurface_stress(

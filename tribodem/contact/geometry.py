@@ -26,8 +26,6 @@ from typing import ClassVar, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.interpolate import LinearNDInterpolator, RegularGridInterpolator
-from scipy.optimize import brentq
 
 from tribodem.contact.base import Recession  # noqa: E402 - one definition, in the contract
 
@@ -92,6 +90,8 @@ class HeightMap:
                 "(and, for the lower body, the whole track)"
             )
         nx, ny = self.values.shape
+        from scipy.interpolate import RegularGridInterpolator  # here: 0.6 s to import
+
         interp = RegularGridInterpolator(
             (self.x0 + self.dx * np.arange(nx), self.y0 + self.dy * np.arange(ny)),
             self.values,
@@ -289,6 +289,8 @@ def punch_contact_radius(punch_radius: float, edge_radius: float, load: float,
     :func:`punch_load` (a > b; Hertz-like growth beyond the flat face)."""
     b, re = punch_radius, edge_radius
     hi = max(2 * b, (3 * load * re / (4 * modulus)) ** (1 / 3)) + b
+    from scipy.optimize import brentq  # here: 0.4 s to import, which every command paid
+
     return float(brentq(lambda a: punch_load(a, b, re, modulus) - load, b, hi, xtol=1e-15,
                         rtol=1e-12))
 
@@ -465,6 +467,8 @@ def load_height_map(path: str | Path, body: str, dx: float | None = None) -> Hei
                              f"points of map_dx {step:.4g} m per side")
         gx, gy = np.meshgrid(x0 + step * np.arange(nx), y0 + step * np.arange(ny),
                              indexing="ij")
+        from scipy.interpolate import LinearNDInterpolator  # here: 0.6 s to import
+
         z = LinearNDInterpolator(pts[:, :2], pts[:, 2])(np.clip(gx, x0, x1),
                                                          np.clip(gy, y0, y1))
         if not np.all(np.isfinite(z)):

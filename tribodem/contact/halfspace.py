@@ -41,7 +41,6 @@ from typing import Any, Literal
 import numpy as np
 import tamaas as tm
 from numpy.typing import NDArray
-from scipy.signal import fftconvolve
 
 from tribodem.contact.base import (
     BODIES,
@@ -290,6 +289,8 @@ class HalfSpaceSolver(FirstBodySolver):
         if self.contact == "line":
             raise ValueError("a debris pressure is not available for a line contact (its "
                              "displacement here is the non-periodic point-contact integral)")
+        from scipy.signal import fftconvolve  # here: scipy.signal takes 0.5 s to import
+
         pd, self._debris_load = checked_debris_pressure(pressure, n, self.dx, self.load)
         self._debris_pressure = pd
         u = fftconvolve(pd, self._kernel, mode="full")[n - 1 : 2 * n - 1, n - 1 : 2 * n - 1]
