@@ -183,6 +183,37 @@ def test_loading_friction_sets_the_seating_and_loading_coefficient(tmp_path: Pat
         _solver(tmp_path / "bad", loading_friction="half")
 
 
+def test_cycle_increments_cap_the_quarters_increments_only(tmp_path: Path) -> None:
+    """``cycle_increments``: the quarters' largest ccx increment is 4 / (n_increments x
+    ceil(cycle_increments / n_increments)) of a quarter's time (the quick preset: 8 and 64,
+    1/16), for either material and beside ``plastic_increments`` (the larger rules); only
+    the quarters' ``*STATIC`` lines change (the first increment is at most the largest), not
+    the output times (``TQUARTER``), the seating or the loading; below 4 or not an integer
+    is refused."""
+    def quarters(**kw: float) -> tuple[list[float], list[str]]:
+        solver = _solver(tmp_path, n_increments=8, **kw)
+        lines = solver.write_deck(tmp_path / "job.inp", solver._mesh0, 1e-6).read_text()
+        lines = lines.splitlines()
+        static = [lines[k + 1] for k, line in enumerate(lines) if line == "*STATIC"]
+        return [float(s.split(",")[3]) for s in static[2:6]], lines
+
+    plain, lines0 = quarters()
+    assert plain == [0.5] * 4
+    capped, lines = quarters(cycle_increments=64)
+    assert capped == [1 / 16] * 4
+    changed = [k for k, (a, b) in enumerate(zip(lines0, lines, strict=True)) if a != b]
+    statics = [k + 1 for k, line in enumerate(lines) if line == "*STATIC"]
+    assert changed == statics[2:6]  # the quarters' *STATIC data lines, nothing else
+    assert quarters(cycle_increments=20)[0] == pytest.approx([4 / 24] * 4, rel=1e-11)  # 8 x 3
+    plastic = dict(material="elastic-plastic", plastic_increments=32)
+    assert quarters(**plastic)[0] == [1 / 8] * 4
+    assert quarters(cycle_increments=64, **plastic)[0] == [1 / 16] * 4
+    assert quarters(cycle_increments=16, **plastic)[0] == [1 / 8] * 4
+    for bad in (3, 8.5):
+        with pytest.raises(ValueError, match=f"cycle_increments = {bad!r} is not allowed"):
+            _solver(tmp_path, cycle_increments=bad)
+
+
 def test_quarters_start_at_a_quarter_of_the_mindlin_slip(tmp_path: Path) -> None:
     """Every quarter of a cycle starts at a reversal, where the contact sticks again: its
     first ccx increment slides REVERSAL_SLIDE (1/4) of the Cattaneo-Mindlin gross-slip

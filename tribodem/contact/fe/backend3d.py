@@ -284,6 +284,10 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
     bodies and 0.001 for elastic ones); ``max_wear_slope``: the steepest worn-depth step /
     column spacing the morphed mesh carries (:func:`.slope.limit_slope`, volume kept; default
     :data:`CONVERGED_SLOPE`; None: the criterion's surface as projected);
+    ``cycle_increments``: the fewest ccx increments per cycle, the output times staying
+    the loop's ``n_increments`` (None: ``n_increments``, and ``plastic_increments`` for
+    elastic-plastic bodies; the quick preset's 64 took 443 -> 299 Newton iterations a cycle,
+    docs/fe3d.md "Timings");
     ``workdir``: the jobs' folder (``cycle_0001/`` ...; None: a new temporary folder).
     ``regime`` and ``tolerance`` are the half-space's options and are not used, nor is
     ``chain_cycles`` (mode ``chained`` of the 2D backend); ``material`` is ``"elastic"`` or
@@ -332,6 +336,7 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         material: str = "elastic",
         chain_cycles: int = 5,
         plastic_increments: int = PLASTIC_MIN_INCREMENTS,
+        cycle_increments: int | None = None,
         yield_strength: float = EN24T.yield_strength,
         uts: float = EN24T.uts,
         uts_strain: float = EN24T.uts_strain,
@@ -406,10 +411,16 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         self.amplitude = _check_positive("amplitude", amplitude)
         self.offsets = cycle_offsets(self.amplitude, n_increments)
         self.n_increments = int(n_increments)
-        #: ccx increments per output increment of the cycle (plastic: at least
-        #: ``plastic_increments`` per cycle)
-        self.cycle_refine = (math.ceil(self.plastic_increments / self.n_increments)
-                             if self.plastic else 1)
+        #: ccx increments per output increment of the cycle: at least ``cycle_increments``
+        #: (any material) and, plastic, ``plastic_increments`` per cycle
+        if cycle_increments is not None and (int(cycle_increments) != cycle_increments
+                                             or cycle_increments < 4):
+            raise ValueError(f"cycle_increments = {cycle_increments!r} is not allowed: an "
+                             "integer >= 4, or None")
+        self.cycle_increments = None if cycle_increments is None else int(cycle_increments)
+        fewest = max(self.plastic_increments if self.plastic else 1,
+                     self.cycle_increments or 1)
+        self.cycle_refine = max(math.ceil(fewest / self.n_increments), 1)
         self.h_over_a = _check_positive("h_over_a", h_over_a)
         self.size_factor = _check_positive("size_factor", size_factor)
         if self.size_factor * a > 0.5 * self.radius:
