@@ -103,7 +103,7 @@ from tribodem.contact.fe.deck import (
     _write_ids,
     sliding_contact,
 )
-from tribodem.contact.fe.jobs import CcxJobs, JobRecord, check_stress_depth
+from tribodem.contact.fe.jobs import CcxJobs, JobRecord, check_stress_depth, checked_increments
 from tribodem.contact.fe.mesh import surface_projection, worn_depth
 from tribodem.contact.fe.results import DatBlock, read_dat
 from tribodem.contact.fe.slope import SlopeLimit, limit_slope, steepest
@@ -287,7 +287,7 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
     ``cycle_increments``: the fewest ccx increments per cycle, the output times staying
     the loop's ``n_increments`` (None: ``n_increments``, and ``plastic_increments`` for
     elastic-plastic bodies; the quick preset's 64 took 443 -> 299 Newton iterations a cycle,
-    docs/fe3d.md "Timings");
+    docs/fe3d.md "Contact set-up", quick preset);
     ``workdir``: the jobs' folder (``cycle_0001/`` ...; None: a new temporary folder).
     ``regime`` and ``tolerance`` are the half-space's options and are not used, nor is
     ``chain_cycles`` (mode ``chained`` of the 2D backend); ``material`` is ``"elastic"`` or
@@ -413,14 +413,11 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         self.n_increments = int(n_increments)
         #: ccx increments per output increment of the cycle: at least ``cycle_increments``
         #: (any material) and, plastic, ``plastic_increments`` per cycle
-        if cycle_increments is not None and (int(cycle_increments) != cycle_increments
-                                             or cycle_increments < 4):
-            raise ValueError(f"cycle_increments = {cycle_increments!r} is not allowed: an "
-                             "integer >= 4, or None")
-        self.cycle_increments = None if cycle_increments is None else int(cycle_increments)
+        self.cycle_increments = (None if cycle_increments is None else
+                                 checked_increments("cycle_increments", cycle_increments))
         fewest = max(self.plastic_increments if self.plastic else 1,
                      self.cycle_increments or 1)
-        self.cycle_refine = max(math.ceil(fewest / self.n_increments), 1)
+        self.cycle_refine = math.ceil(fewest / self.n_increments)
         self.h_over_a = _check_positive("h_over_a", h_over_a)
         self.size_factor = _check_positive("size_factor", size_factor)
         if self.size_factor * a > 0.5 * self.radius:

@@ -154,6 +154,14 @@ def _known_failure(deck: Path, key: str) -> str | None:
     return message if first == key else None
 
 
+def checked_increments(name: str, value: float) -> int:
+    """``value`` as ccx increments per cycle: an integer >= 4 (``ValueError`` naming
+    ``name`` otherwise)."""
+    if int(value) != value or value < 4:
+        raise ValueError(f"{name} = {value!r} is not allowed: an integer >= 4")
+    return int(value)
+
+
 def attempt_settings(attempt: int) -> tuple[int, float]:
     """(increment refinement, contact penalty scale) of ``run_job``'s attempt ``attempt`` (0:
     the job as configured): the retries halve the increments and the contact's penalty
@@ -383,10 +391,7 @@ class CcxJobs:
                              f"{', '.join(MATERIALS)}")
         self.material = material
         self.plastic = material == "elastic-plastic"
-        if int(plastic_increments) != plastic_increments or plastic_increments < 4:
-            raise ValueError(f"plastic_increments = {plastic_increments!r} is not allowed: "
-                             "an integer >= 4")
-        self.plastic_increments = int(plastic_increments)
+        self.plastic_increments = checked_increments("plastic_increments", plastic_increments)
         self.plastic_law = FEMaterial(
             yield_strength=_check_positive("yield_strength", yield_strength),
             uts=_check_positive("uts", uts), uts_strain=_check_positive("uts_strain", uts_strain),
