@@ -17,9 +17,10 @@ Closed forms and tolerances (seed 003: EN24T crossed cylinders R = 4 mm, 100 N, 
 * the installed command ``tribodem fretting run --solver fe3d --quick`` runs a cycle and
   resumes for a second (2 ccx jobs), writing its results, jobs.csv and the decks.
 
-ccx budget on 1 thread (measured, docs/fe3d.md): one h = a/3 job (bodies 6 a, +-10 um, 4
-increments) shared by the Hertz and slip tests, and two h = a jobs for the command (the
-quick preset: +-0.3 mm in 8 increments; 80 s with Debian's ccx, 36 s with ccx_pardiso).
+ccx budget on 1 thread (measured, docs/fe3d.md, BENCHMARKS.md "Session 39"): one h = a/3
+job (compact bodies 4 a, ``fe3d_cases.COMPACT``; +-10 um, 4 increments; 62 s with Debian's
+ccx, 131 s on bodies 6 a) shared by the Hertz and slip tests, and two h = a jobs for the
+command (the quick preset: +-0.3 mm, 64 ccx increments a cycle; ~56 s with Debian's ccx).
 Everything skips without ccx.
 """
 
@@ -34,7 +35,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from conftest import run_tribodem
-from fe3d_cases import AMPLITUDE, LOAD, P0, A, _solver
+from fe3d_cases import AMPLITUDE, COMPACT, LOAD, P0, A, _solver
 
 from tribodem.contact import ElasticBody
 from tribodem.contact.fe.backend3d import FE3DContactSolver, hex_volumes, mesh_columns
@@ -300,7 +301,7 @@ def test_an_old_default_fe3d_checkpoint_resumes_on_fe3ds_own_mesh() -> None:
 
 @pytest.fixture(scope="module")
 def served(tmp_path_factory: pytest.TempPathFactory):  # noqa: ANN201
-    solver = _solver(tmp_path_factory.mktemp("fe3d"))
+    solver = _solver(tmp_path_factory.mktemp("fe3d"), **COMPACT)
     solver.reset()
     loaded = solver.solve_increment(0.0)
     solver.begin_cycle()
@@ -322,14 +323,15 @@ def test_hertz_point_contact(served) -> None:  # noqa: ANN001
     r2 = c[:, None] ** 2 + c[None, :] ** 2
     # the window holds the bilinear interpolant of the nodal pressures, whose second moment
     # exceeds the nodes' by h^2 / 3 (h^2 / 6 per direction, exact on the uniform fine grid):
-    # measured +5.4 % on a before, +0.9 % after removing it at h = a/3
+    # measured +5.4 % on a before, +0.9 % after removing it at h = a/3 (bodies 6 a; 4 a: +0.4 %)
     h = solver._mesh0.h_fine
     a_moment = math.sqrt(2.5 * (float((r2 * p).sum() / p.sum()) - h * h / 3.0))
     assert a_moment == pytest.approx(A, rel=0.03)
     np.testing.assert_allclose(p[:, 1:], p[:, 1:][:, ::-1], rtol=1e-9)  # mirror, y = 0
     # contact area: window points where the nodes' contact indicator interpolates to >= 1/2
     # (the FE contact edge lies between a contact node and a free one): measured +15.8 % of
-    # pi a^2 at h = a/3 (the pressure's support on the window, one node further: +97 %)
+    # pi a^2 at h = a/3 on bodies 6 a, +14.4 % on 4 a (the pressure's support on the window,
+    # one node further: +97 %)
     assert loaded.contact_area == pytest.approx(math.pi * A * A, rel=0.25)
     # the model itself: the nodal pressures' Hertz fit
     st = solver._states[0]
@@ -367,7 +369,8 @@ def test_gross_slip_and_signs(served) -> None:  # noqa: ANN001
     # takes part of each stroke. Cattaneo-Mindlin (Johnson 7.41), delta* = 3 mu P / (16 a)
     # sum (2 - nu) / G: from virgin bodies to gross slip 0.8 delta* of the stroke is not
     # slid, at each of the two reversals 1.6 delta*: E = 4 mu P (A - delta*) for the fresh
-    # cycle 0 -> +A -> 0 -> -A -> 0; within 5 % (measured -1.6 % at A = 10 um, h = a/3)
+    # cycle 0 -> +A -> 0 -> -A -> 0; within 5 % (measured at A = 10 um, h = a/3: -1.6 % on
+    # bodies 6 a, -2.4 % on these 4 a: the finite bodies' compliance, fe3d_cases.COMPACT)
     energy = sum(float(i.energy_density.sum()) * cell for i in incs)
     poisson, shear = ElasticBody().poisson, ElasticBody().shear
     delta_star = 3 * mu * LOAD / (16 * A) * 2 * (2 - poisson) / shear
@@ -377,7 +380,8 @@ def test_gross_slip_and_signs(served) -> None:  # noqa: ANN001
 def test_subsurface_stress_on_the_axis(served) -> None:  # noqa: ANN001
     """Hertz point contact on the axis (Johnson 3.71): sigma_zz = -p0 / (1 + z^2 / a^2)
     within 12 % of p0 at h = a/3 (linear elements, the column profile linear between nodes
-    a/3 apart: measured 10.4 % at z = a/2); both bodies alike under the load."""
+    a/3 apart: measured 10.4 % at z = a/2 on bodies 6 a, 9.2 % on 4 a); both bodies alike
+    under the load."""
     solver, loaded, incs = served
     lower = solver.subsurface_stress(loaded, "lower", depth=2 * A, nz=21)
     upper = solver.subsurface_stress(loaded, "upper", depth=2 * A, nz=21)
