@@ -17,6 +17,7 @@ import numpy as np
 from numba import njit, prange
 
 from tribodem.dem import laws
+from tribodem.dem.integrate import BLOCK
 from tribodem.dem.jit import kernel
 from tribodem.dem.laws import law_normal
 from tribodem.dem.laws.table import (  # noqa: F401 - the table's columns, re-exported
@@ -451,6 +452,10 @@ def pair_forces_sum(pos, vel, omega, radius, mass, inertia, mat, pair_i, pair_j,
 BLOCKS_PER_THREAD = 2
 #: the work of a touching pair against a listed pair found apart, for the block cuts
 CONTACT_WORK = 3.0
+#: the work of a particle's update against a listed pair's, for the block cuts (the
+#: threaded loop updates a thread's particles in the region of their pairs,
+#: ``engine._pairs_update``; settle3d: ~6 ns an update, ~10 ns a listed pair)
+PARTICLE_WORK = 0.6
 
 
 @njit(cache=True)
@@ -460,10 +465,14 @@ def pair_block_bounds(start, pinfo, nblk, bounds):  # pragma: no cover - numba
     particle's work is its own row of the list, a listed pair counting 1 and a pair
     touching at the last evaluation (``pinfo[p, 0] > 0``) ``1 + CONTACT_WORK`` (in a
     settling bed the bottom blocks hold most contacts: equal particle counts left one
-    thread idle). Any cut gives the same sums (``pair_forces_blocked``), so the cuts may
-    change at any step without changing a bit."""
+    thread idle), plus ``PARTICLE_WORK`` per particle for its update. The cuts between
+    threads' shares (every ``BLOCKS_PER_THREAD``-th) fall between blocks of
+    ``integrate.BLOCK`` particles: the threaded loop updates each thread's particles in
+    the region that summed their pairs (``engine._pairs_update``). Any cut gives the same
+    sums (``pair_forces_blocked``), so the cuts may change at any step without changing
+    a bit."""
     n = start.shape[0] - 1
-    total = 0.0
+    total = PARTICLE_WORK * n
     for p in range(start[n]):
         total += 1.0 + (CONTACT_WORK if pinfo[p, 0] > 0.0 else 0.0)
     bounds[0] = 0
@@ -472,9 +481,11 @@ def pair_block_bounds(start, pinfo, nblk, bounds):  # pragma: no cover - numba
     for i in range(n):
         if b >= nblk:
             break
+        acc += PARTICLE_WORK
         for p in range(start[i], start[i + 1]):
             acc += 1.0 + (CONTACT_WORK if pinfo[p, 0] > 0.0 else 0.0)
-        while b < nblk and acc >= total * b / nblk:
+        while (b < nblk and acc >= total * b / nblk
+               and (b % BLOCKS_PER_THREAD or (i + 1) % BLOCK == 0)):
             bounds[b] = i + 1
             b += 1
     while b < nblk:
@@ -583,91 +594,101 @@ def pair_forces_blocked(pos, vel, omega, radius, mass, inertia, mat, start, pair
     a sum's bits as they are (a running sum from +0 is never -0)."""
     nblk = bounds.shape[0] - 1
     for blk in prange(nblk):
-        b0_ = bounds[blk]
-        b1 = bounds[blk + 1]
-        for k in range(b0_, b1):
-            s0 = s1 = s2 = u0 = u1 = u2 = 0.0
-            for q in range(rev_start[k], rev_start[k + 1]):
-                p = rev_pair[q]
-                if pair_i[p] >= b0_:
-                    break
-                s0 += fpair[p, 0]
-                s1 += fpair[p, 1]
-                s2 += fpair[p, 2]
-                u0 += tpair_j[p, 0]
-                u1 += tpair_j[p, 1]
-                u2 += tpair_j[p, 2]
-            force[k, 0] = s0
-            force[k, 1] = s1
-            force[k, 2] = s2
-            torque[k, 0] = u0
-            torque[k, 1] = u1
-            torque[k, 2] = u2
-        for i in range(b0_, b1):
-            for p in range(start[i], start[i + 1]):
-                j = pair_j[p]
-                if j >= b1:  # cross pair: evaluated by pair_forces_cross
-                    force[i, 0] -= fpair[p, 0]
-                    force[i, 1] -= fpair[p, 1]
-                    force[i, 2] -= fpair[p, 2]
-                    torque[i, 0] += tpair_i[p, 0]
-                    torque[i, 1] += tpair_i[p, 1]
-                    torque[i, 2] += tpair_i[p, 2]
-                    continue
-                d0 = min_image(pos[j, 0] - pos[i, 0], length[0], periodic[0])
-                d1 = min_image(pos[j, 1] - pos[i, 1], length[1], periodic[1])
-                d2 = min_image(pos[j, 2] - pos[i, 2], length[2], periodic[2])
-                ri = radius[i]
-                rj = radius[j]
-                dist2 = d0 * d0 + d1 * d1 + d2 * d2
-                rs = ri + rj
-                if dist2 > rs * rs * APART and not pinfo[p, 0] > 0.0:
-                    continue  # apart now and at the last evaluation
-                dist = np.sqrt(dist2)
-                delta = rs - dist
-                if not (delta > 0.0 and dist2 > 0.0):  # apart: clear a contact just ended
-                    if pinfo[p, 0] > 0.0:
-                        for k in range(3):
-                            hist[p, k] = 0.0
-                            fpair[p, k] = 0.0
-                            tpair_i[p, k] = 0.0
-                            tpair_j[p, k] = 0.0
-                        pinfo[p, 1] = 0.0
-                        pinfo[p, 2] = 0.0
-                        pinfo[p, 3] = 0.0
-                    pinfo[p, 0] = delta
-                    continue
-                prop = pairtab[mat[i], mat[j]]
-                lin_k, rstar, mstar, istar = _pair_consts(
-                    prop, ri, rj, mass[i], mass[j], inertia[i], inertia[j], elin[mat[i]],
-                    elin[mat[j]], dim, thickness)
-                (f0, f1, f2, a0, a1, a2, c0, c1, c2, delta, fn, energy, kn, h0, h1,
-                 h2) = _pair(d0, d1, d2, dist, ri, rj, vel[i, 0], vel[i, 1], vel[i, 2],
-                             vel[j, 0], vel[j, 1], vel[j, 2], omega[i, 0], omega[i, 1],
-                             omega[i, 2], omega[j, 0], omega[j, 1], omega[j, 2], rstar, mstar,
-                             istar, prop, lin_k, hist[p, 0], hist[p, 1], hist[p, 2], dt)
-                hist[p, 0] = h0
-                hist[p, 1] = h1
-                hist[p, 2] = h2
-                fpair[p, 0] = f0
-                fpair[p, 1] = f1
-                fpair[p, 2] = f2
+        pair_block(pos, vel, omega, radius, mass, inertia, mat, start, pair_i, pair_j,
+                   rev_start, rev_pair, hist, pairtab, elin, length, periodic, dim, thickness,
+                   dt, fpair, tpair_i, tpair_j, pinfo, force, torque, bounds[blk],
+                   bounds[blk + 1])
+
+
+@njit(cache=True, inline="always")
+def pair_block(pos, vel, omega, radius, mass, inertia, mat, start, pair_i, pair_j, rev_start,
+               rev_pair, hist, pairtab, elin, length, periodic, dim, thickness, dt, fpair,
+               tpair_i, tpair_j, pinfo, force, torque, b0_, b1):  # pragma: no cover - numba
+    """``pair_forces_blocked`` for the block of particles ``b0_:b1``: afterwards their
+    ``force`` / ``torque`` hold all their pairs' sums."""
+    for k in range(b0_, b1):
+        s0 = s1 = s2 = u0 = u1 = u2 = 0.0
+        for q in range(rev_start[k], rev_start[k + 1]):
+            p = rev_pair[q]
+            if pair_i[p] >= b0_:
+                break
+            s0 += fpair[p, 0]
+            s1 += fpair[p, 1]
+            s2 += fpair[p, 2]
+            u0 += tpair_j[p, 0]
+            u1 += tpair_j[p, 1]
+            u2 += tpair_j[p, 2]
+        force[k, 0] = s0
+        force[k, 1] = s1
+        force[k, 2] = s2
+        torque[k, 0] = u0
+        torque[k, 1] = u1
+        torque[k, 2] = u2
+    for i in range(b0_, b1):
+        for p in range(start[i], start[i + 1]):
+            j = pair_j[p]
+            if j >= b1:  # cross pair: evaluated by pair_forces_cross
+                force[i, 0] -= fpair[p, 0]
+                force[i, 1] -= fpair[p, 1]
+                force[i, 2] -= fpair[p, 2]
+                torque[i, 0] += tpair_i[p, 0]
+                torque[i, 1] += tpair_i[p, 1]
+                torque[i, 2] += tpair_i[p, 2]
+                continue
+            d0 = min_image(pos[j, 0] - pos[i, 0], length[0], periodic[0])
+            d1 = min_image(pos[j, 1] - pos[i, 1], length[1], periodic[1])
+            d2 = min_image(pos[j, 2] - pos[i, 2], length[2], periodic[2])
+            ri = radius[i]
+            rj = radius[j]
+            dist2 = d0 * d0 + d1 * d1 + d2 * d2
+            rs = ri + rj
+            if dist2 > rs * rs * APART and not pinfo[p, 0] > 0.0:
+                continue  # apart now and at the last evaluation
+            dist = np.sqrt(dist2)
+            delta = rs - dist
+            if not (delta > 0.0 and dist2 > 0.0):  # apart: clear a contact just ended
+                if pinfo[p, 0] > 0.0:
+                    for k in range(3):
+                        hist[p, k] = 0.0
+                        fpair[p, k] = 0.0
+                        tpair_i[p, k] = 0.0
+                        tpair_j[p, k] = 0.0
+                    pinfo[p, 1] = 0.0
+                    pinfo[p, 2] = 0.0
+                    pinfo[p, 3] = 0.0
                 pinfo[p, 0] = delta
-                pinfo[p, 1] = fn
-                pinfo[p, 2] = energy
-                pinfo[p, 3] = kn
-                force[i, 0] -= f0
-                force[i, 1] -= f1
-                force[i, 2] -= f2
-                torque[i, 0] += a0
-                torque[i, 1] += a1
-                torque[i, 2] += a2
-                force[j, 0] += f0
-                force[j, 1] += f1
-                force[j, 2] += f2
-                torque[j, 0] += c0
-                torque[j, 1] += c1
-                torque[j, 2] += c2
+                continue
+            prop = pairtab[mat[i], mat[j]]
+            lin_k, rstar, mstar, istar = _pair_consts(
+                prop, ri, rj, mass[i], mass[j], inertia[i], inertia[j], elin[mat[i]],
+                elin[mat[j]], dim, thickness)
+            (f0, f1, f2, a0, a1, a2, c0, c1, c2, delta, fn, energy, kn, h0, h1,
+             h2) = _pair(d0, d1, d2, dist, ri, rj, vel[i, 0], vel[i, 1], vel[i, 2],
+                         vel[j, 0], vel[j, 1], vel[j, 2], omega[i, 0], omega[i, 1],
+                         omega[i, 2], omega[j, 0], omega[j, 1], omega[j, 2], rstar, mstar,
+                         istar, prop, lin_k, hist[p, 0], hist[p, 1], hist[p, 2], dt)
+            hist[p, 0] = h0
+            hist[p, 1] = h1
+            hist[p, 2] = h2
+            fpair[p, 0] = f0
+            fpair[p, 1] = f1
+            fpair[p, 2] = f2
+            pinfo[p, 0] = delta
+            pinfo[p, 1] = fn
+            pinfo[p, 2] = energy
+            pinfo[p, 3] = kn
+            force[i, 0] -= f0
+            force[i, 1] -= f1
+            force[i, 2] -= f2
+            torque[i, 0] += a0
+            torque[i, 1] += a1
+            torque[i, 2] += a2
+            force[j, 0] += f0
+            force[j, 1] += f1
+            force[j, 2] += f2
+            torque[j, 0] += c0
+            torque[j, 1] += c1
+            torque[j, 2] += c2
 
 
 @njit(cache=True, inline="always")

@@ -38,6 +38,7 @@ from tribodem.dem.contact import (
     HIST,
     N_PCONST,
     Material,
+    pair_block,
     pair_block_bounds,
     pair_constants,
     pair_cross_list,
@@ -48,7 +49,7 @@ from tribodem.dem.contact import (
     pair_table,
 )
 from tribodem.dem.errors import SimulationUnstable, TimeStepError
-from tribodem.dem.integrate import BLOCK, advance, critical_step
+from tribodem.dem.integrate import BLOCK, advance, advance_block, critical_step
 from tribodem.dem.jit import serial_run
 from tribodem.dem.space import Box
 from tribodem.dem.state import ParticleState
@@ -92,9 +93,7 @@ _walls_pass = wall_forces.serial
 _advance_serial = advance.serial
 # and their threaded builds (the loop of a large system on several threads)
 _cross_par = pair_forces_cross.parallel
-_blocked_par = pair_forces_blocked.parallel
 _walls_par = wall_forces.parallel
-_advance_par = advance.parallel
 _SERVO = WALL_MODES.index("servo")
 _BOUNDARY = WALL_MODES.index("boundary")
 
@@ -195,12 +194,55 @@ RUN_DONE, RUN_REBUILD, RUN_EVENT, RUN_UNSTABLE = 0, 1, 2, 3
 
 
 @numba.njit(cache=True)
+def _wall_normal_forces(c):  # pragma: no cover - numba
+    """``Simulation._wall_pass``'s normal force of the particles on each wall (N)."""
+    for w in range(c.wall_point.shape[0]):
+        c.wall_nf[w] = -(c.wall_tot[w, 0] * c.wall_normal[w, 0]
+                         + c.wall_tot[w, 1] * c.wall_normal[w, 1]
+                         + c.wall_tot[w, 2] * c.wall_normal[w, 2])
+
+
+@numba.njit(cache=True, parallel=True)
+def _pairs_update(pos, vel, omega, radius, mass, inertia, mat, fixed, start, pair_i, pair_j,
+                  rev_start, rev_pair, hist, pairtab, elin, length, periodic, dim, thickness,
+                  dt, fpair, tpair_i, tpair_j, pinfo, force, torque, wstart, wforce, wtorque,
+                  gravity, viscous, local, ref_pos, ref_radius, lo, drift,
+                  bounds):  # pragma: no cover - numba
+    """The threaded loop's second pass (after ``pair_forces_cross`` and the walls; no
+    interactions), one threaded region: each thread takes its ``BLOCKS_PER_THREAD`` blocks
+    of ``bounds`` (``pair_block_bounds``; the cuts between threads fall between update
+    blocks), sums their pairs (``contact.pair_block``: afterwards its particles' sums are
+    complete, as no other block's pairs reach them but the cross pairs already stored)
+    and then updates its particles (``integrate.advance_block``). A thread thus updates
+    the particles whose pairs it summed, in the same region: the separate update region
+    (equal particle counts, while the pair cuts are by work) handed ~10 % of settle3d's
+    particles from one thread to the other every step, which cost 3.5 % when the VM's two
+    vCPUs sit on different L3 caches (BENCHMARKS.md, session 40). The same operations on
+    each particle as the serial loop: the same bits."""
+    nt = (bounds.shape[0] - 1) // BLOCKS_PER_THREAD
+    for t in numba.prange(nt):
+        for b in range(t * BLOCKS_PER_THREAD, (t + 1) * BLOCKS_PER_THREAD):
+            pair_block(pos, vel, omega, radius, mass, inertia, mat, start, pair_i, pair_j,
+                       rev_start, rev_pair, hist, pairtab, elin, length, periodic, dim,
+                       thickness, dt, fpair, tpair_i, tpair_j, pinfo, force, torque,
+                       bounds[b], bounds[b + 1])
+        first = bounds[t * BLOCKS_PER_THREAD]  # the thread's particles, cut on blocks
+        end = bounds[(t + 1) * BLOCKS_PER_THREAD]
+        for blk in range((first + BLOCK - 1) // BLOCK, (end + BLOCK - 1) // BLOCK):
+            advance_block(pos, vel, omega, radius, mass, inertia, fixed, wstart, wforce,
+                          wtorque, dt, gravity, viscous, local, False, force, torque,
+                          force, torque, ref_pos, ref_radius, lo, length, periodic, drift,
+                          blk)
+
+
+@numba.njit(cache=True)
 def _run_steps(c, states, nmax, step0, check_every, max_ratio, bounds, xpairs,
                nx):  # pragma: no cover
     """Up to ``nmax`` steps of ``Simulation.step`` in one compiled loop (the same kernels,
     operations and order as the Python loop, so the same bits): pair contacts -> the
     interactions' compiled steps (``states``, in order) -> wall pass and the walls'
-    totals -> particle update -> wall motion -> clock. The first step starts at once (the
+    totals -> particle update -> wall motion -> clock (threaded, without interactions:
+    cross pairs -> walls -> ``_pairs_update``, the same values). The first step starts at once (the
     caller has just checked the neighbour list); before each later one the rebuild test
     runs and, if due, the loop stops. After every step whose count (from ``step0``) is a
     multiple of ``check_every`` the stability test runs (``_unstable``) and stops the
@@ -227,7 +269,8 @@ def _run_steps(c, states, nmax, step0, check_every, max_ratio, bounds, xpairs,
         if k > 0 and _must_rebuild(c):
             why = RUN_REBUILD
             break
-        if bounds is not None:  # threaded: the blocked Newton pairs
+        ev = 0
+        if bounds is not None:  # threaded (no interactions): the blocked Newton pairs
             if k > 0 and (step0 + k) % REBALANCE_EVERY == 0:
                 pair_block_bounds(c.start, c.pinfo, bounds.shape[0] - 1, bounds)
                 nx[0] = pair_cross_list(c.pair_i, c.pair_j, bounds, xpairs)
@@ -235,54 +278,47 @@ def _run_steps(c, states, nmax, step0, check_every, max_ratio, bounds, xpairs,
                        c.pair_j, c.hist, c.pairtab, c.elin, c.length, c.periodic, c.dim,
                        c.thickness, c.dt, c.fpair, c.tpair_i, c.tpair_j, c.pinfo, xpairs,
                        nx[0])
-            _blocked_par(c.pos, c.vel, c.omega, c.radius, c.mass, c.inertia, c.mat, c.start,
-                         c.pair_i, c.pair_j, c.rev_start, c.rev_pair, c.hist, c.pairtab,
-                         c.elin, c.length, c.periodic, c.dim, c.thickness, c.dt, c.fpair,
-                         c.tpair_i, c.tpair_j, c.pinfo, c.force, c.torque, bounds)
-        elif c.dim == 2:
-            _pairs_2d(c.pos, c.vel, c.omega, c.radius, c.mass, c.inertia, c.mat, c.pair_i,
-                      c.pair_j, c.hist, c.pairtab, c.elin, c.length, c.periodic, c.dim,
-                      c.thickness, c.dt, c.fpair, c.tpair_i, c.tpair_j, c.pinfo, c.force,
-                      c.torque, pconst)
-        else:
-            _pairs_3d(c.pos, c.vel, c.omega, c.radius, c.mass, c.inertia, c.mat, c.pair_i,
-                      c.pair_j, c.hist, c.pairtab, c.elin, c.length, c.periodic, c.dim,
-                      c.thickness, c.dt, c.fpair, c.tpair_i, c.tpair_j, c.pinfo, c.force,
-                      c.torque, pconst)
-        ev = 0
-        if c.has_ext:
-            for i in range(n):
-                for d in range(3):
-                    c.ext_force[i, d] = 0.0
-                    c.ext_torque[i, d] = 0.0
-            ev = _interactions(states, c)
-        if nw:
-            if bounds is None:
-                _walls_pass(c.pos, c.vel, c.omega, c.radius, c.mass, c.inertia, c.mat,
-                            c.wstart, c.wid, c.wpart, c.wbstart, c.wall_point, c.wall_normal,
-                            c.wall_vel, c.wall_mat, c.wall_hist, c.wall_info, c.wsum,
-                            c.pairtab, c.elin, c.dim, c.thickness, c.dt, c.wforce, c.wtorque,
-                            c.wall_tot)
-            else:
+            if nw:  # the walls first: they need no pair force
                 _walls_par(c.pos, c.vel, c.omega, c.radius, c.mass, c.inertia, c.mat,
                            c.wstart, c.wid, c.wpart, c.wbstart, c.wall_point, c.wall_normal,
                            c.wall_vel, c.wall_mat, c.wall_hist, c.wall_info, c.wsum,
                            c.pairtab, c.elin, c.dim, c.thickness, c.dt, c.wforce, c.wtorque,
                            c.wall_tot)
-            for w in range(nw):  # Simulation._wall_pass: the normal force on each wall
-                c.wall_nf[w] = -(c.wall_tot[w, 0] * c.wall_normal[w, 0]
-                                 + c.wall_tot[w, 1] * c.wall_normal[w, 1]
-                                 + c.wall_tot[w, 2] * c.wall_normal[w, 2])
-        if bounds is None:
+                _wall_normal_forces(c)
+            _pairs_update(c.pos, c.vel, c.omega, c.radius, c.mass, c.inertia, c.mat, c.fixed,
+                          c.start, c.pair_i, c.pair_j, c.rev_start, c.rev_pair, c.hist,
+                          c.pairtab, c.elin, c.length, c.periodic, c.dim, c.thickness, c.dt,
+                          c.fpair, c.tpair_i, c.tpair_j, c.pinfo, c.force, c.torque,
+                          c.wstart, c.wforce, c.wtorque, c.gravity, c.viscous, c.local,
+                          c.ref_pos, c.ref_radius, c.lo, c.drift, bounds)
+        else:
+            if c.dim == 2:
+                _pairs_2d(c.pos, c.vel, c.omega, c.radius, c.mass, c.inertia, c.mat,
+                          c.pair_i, c.pair_j, c.hist, c.pairtab, c.elin, c.length,
+                          c.periodic, c.dim, c.thickness, c.dt, c.fpair, c.tpair_i,
+                          c.tpair_j, c.pinfo, c.force, c.torque, pconst)
+            else:
+                _pairs_3d(c.pos, c.vel, c.omega, c.radius, c.mass, c.inertia, c.mat,
+                          c.pair_i, c.pair_j, c.hist, c.pairtab, c.elin, c.length,
+                          c.periodic, c.dim, c.thickness, c.dt, c.fpair, c.tpair_i,
+                          c.tpair_j, c.pinfo, c.force, c.torque, pconst)
+            if c.has_ext:
+                for i in range(n):
+                    for d in range(3):
+                        c.ext_force[i, d] = 0.0
+                        c.ext_torque[i, d] = 0.0
+                ev = _interactions(states, c)
+            if nw:
+                _walls_pass(c.pos, c.vel, c.omega, c.radius, c.mass, c.inertia, c.mat,
+                            c.wstart, c.wid, c.wpart, c.wbstart, c.wall_point, c.wall_normal,
+                            c.wall_vel, c.wall_mat, c.wall_hist, c.wall_info, c.wsum,
+                            c.pairtab, c.elin, c.dim, c.thickness, c.dt, c.wforce, c.wtorque,
+                            c.wall_tot)
+                _wall_normal_forces(c)
             _advance_serial(c.pos, c.vel, c.omega, c.radius, c.mass, c.inertia, c.fixed,
                             c.wstart, c.wforce, c.wtorque, c.dt, c.gravity, c.viscous,
                             c.local, c.has_ext, c.ext_force, c.ext_torque, c.force, c.torque,
                             c.ref_pos, c.ref_radius, c.lo, c.length, c.periodic, c.drift)
-        else:
-            _advance_par(c.pos, c.vel, c.omega, c.radius, c.mass, c.inertia, c.fixed,
-                         c.wstart, c.wforce, c.wtorque, c.dt, c.gravity, c.viscous,
-                         c.local, c.has_ext, c.ext_force, c.ext_torque, c.force, c.torque,
-                         c.ref_pos, c.ref_radius, c.lo, c.length, c.periodic, c.drift)
         _move_walls(c)
         t += c.dt
         k += 1

@@ -79,6 +79,20 @@ def advance(pos, vel, omega, radius, mass, inertia, fixed, wstart, wforce, wtorq
     """
     n = pos.shape[0]
     nblocks = (n + BLOCK - 1) // BLOCK
+    for blk in prange(nblocks):
+        advance_block(pos, vel, omega, radius, mass, inertia, fixed, wstart, wforce,
+                      wtorque, dt, gravity, viscous, local, has_ext, ext_force, ext_torque,
+                      force, torque, ref_pos, ref_radius, lo, length, periodic, drift, blk)
+
+
+@njit(cache=True, inline="always")
+def advance_block(pos, vel, omega, radius, mass, inertia, fixed, wstart, wforce, wtorque,
+                  dt, gravity, viscous, local, has_ext, ext_force, ext_torque, force, torque,
+                  ref_pos, ref_radius, lo, length, periodic, drift,
+                  blk):  # pragma: no cover - numba
+    """``advance`` for the particles of block ``blk`` (``BLOCK`` particles): the same
+    arguments; writes ``drift[blk]``."""
+    n = pos.shape[0]
     h = 0.5 * viscous * dt
     a = (1.0 - h) / (1.0 + h)
     b = dt / (1.0 + h)
@@ -86,98 +100,97 @@ def advance(pos, vel, omega, radius, mass, inertia, fixed, wstart, wforce, wtorq
     g1 = gravity[1]
     g2 = gravity[2]
     wrap = periodic[0] or periodic[1] or periodic[2]
-    for blk in prange(nblocks):
-        dmax = 0.0
-        dmax2 = 0.0
-        for i in range(blk * BLOCK, min(n, (blk + 1) * BLOCK)):
-            f0 = force[i, 0]
-            f1 = force[i, 1]
-            f2 = force[i, 2]
-            t0 = torque[i, 0]
-            t1 = torque[i, 1]
-            t2 = torque[i, 2]
-            if wstart[i + 1] > wstart[i]:
-                f0 += wforce[i, 0]
-                f1 += wforce[i, 1]
-                f2 += wforce[i, 2]
-                t0 += wtorque[i, 0]
-                t1 += wtorque[i, 1]
-                t2 += wtorque[i, 2]
-            if has_ext:
-                f0 += ext_force[i, 0]
-                f1 += ext_force[i, 1]
-                f2 += ext_force[i, 2]
-                t0 += ext_torque[i, 0]
-                t1 += ext_torque[i, 1]
-                t2 += ext_torque[i, 2]
-            force[i, 0] = f0
-            force[i, 1] = f1
-            force[i, 2] = f2
-            torque[i, 0] = t0
-            torque[i, 1] = t1
-            torque[i, 2] = t2
-            m = mass[i]
-            fx = fixed[i]
-            if fx == FIX_2D and local == 0.0:
-                # a free disk (x, y, rz; z, rx, ry fixed): ``_update``'s general path
-                # written out for it (the same operations, without its per-DOF loops)
-                vel[i, 0] = a * vel[i, 0] + b * (f0 + m * g0) / m
-                vel[i, 1] = a * vel[i, 1] + b * (f1 + m * g1) / m
-                omega[i, 2] = a * omega[i, 2] + b * t2 / inertia[i]
-                pos[i, 0] += vel[i, 0] * dt
-                pos[i, 1] += vel[i, 1] * dt
-                pos[i, 2] += vel[i, 2] * dt
-            elif fx == 0 and local == 0.0:
-                # a free sphere (no fixity, no local damping), written out with every load
-                # before the first store (through the inlined ``_update``, with the arrays
-                # handed to it, the serial build ran 1.8x slower)
-                bm = b / m
-                v0 = a * vel[i, 0] + bm * (f0 + m * g0)
-                v1 = a * vel[i, 1] + bm * (f1 + m * g1)
-                v2 = a * vel[i, 2] + bm * (f2 + m * g2)
-                bi = b / inertia[i]
-                w0 = a * omega[i, 0] + bi * t0
-                w1 = a * omega[i, 1] + bi * t1
-                w2 = a * omega[i, 2] + bi * t2
-                x0 = pos[i, 0] + v0 * dt
-                x1 = pos[i, 1] + v1 * dt
-                x2 = pos[i, 2] + v2 * dt
-                vel[i, 0] = v0
-                vel[i, 1] = v1
-                vel[i, 2] = v2
-                omega[i, 0] = w0
-                omega[i, 1] = w1
-                omega[i, 2] = w2
-                pos[i, 0] = x0
-                pos[i, 1] = x1
-                pos[i, 2] = x2
-            else:
-                _update(pos, vel, omega, i, f0 + m * g0, f1 + m * g1, f2 + m * g2, t0, t1,
-                        t2, m, inertia[i], fx, a, b, local, dt)
-            if wrap:
-                for k in range(3):
-                    if periodic[k]:
-                        x = pos[i, k] - lo[k]
-                        if x < 0.0 or x >= length[k]:
-                            x -= length[k] * np.floor(x / length[k])
-                            if x >= length[k]:
-                                x -= length[k]
-                            pos[i, k] = lo[k] + x
-            # drift_of without a square root per particle: sqrt is monotonic, so the
-            # largest move is the root of the largest squared move (growth kept apart)
-            dd = 0.0
+    dmax = 0.0
+    dmax2 = 0.0
+    for i in range(blk * BLOCK, min(n, (blk + 1) * BLOCK)):
+        f0 = force[i, 0]
+        f1 = force[i, 1]
+        f2 = force[i, 2]
+        t0 = torque[i, 0]
+        t1 = torque[i, 1]
+        t2 = torque[i, 2]
+        if wstart[i + 1] > wstart[i]:
+            f0 += wforce[i, 0]
+            f1 += wforce[i, 1]
+            f2 += wforce[i, 2]
+            t0 += wtorque[i, 0]
+            t1 += wtorque[i, 1]
+            t2 += wtorque[i, 2]
+        if has_ext:
+            f0 += ext_force[i, 0]
+            f1 += ext_force[i, 1]
+            f2 += ext_force[i, 2]
+            t0 += ext_torque[i, 0]
+            t1 += ext_torque[i, 1]
+            t2 += ext_torque[i, 2]
+        force[i, 0] = f0
+        force[i, 1] = f1
+        force[i, 2] = f2
+        torque[i, 0] = t0
+        torque[i, 1] = t1
+        torque[i, 2] = t2
+        m = mass[i]
+        fx = fixed[i]
+        if fx == FIX_2D and local == 0.0:
+            # a free disk (x, y, rz; z, rx, ry fixed): ``_update``'s general path
+            # written out for it (the same operations, without its per-DOF loops)
+            vel[i, 0] = a * vel[i, 0] + b * (f0 + m * g0) / m
+            vel[i, 1] = a * vel[i, 1] + b * (f1 + m * g1) / m
+            omega[i, 2] = a * omega[i, 2] + b * t2 / inertia[i]
+            pos[i, 0] += vel[i, 0] * dt
+            pos[i, 1] += vel[i, 1] * dt
+            pos[i, 2] += vel[i, 2] * dt
+        elif fx == 0 and local == 0.0:
+            # a free sphere (no fixity, no local damping), written out with every load
+            # before the first store (through the inlined ``_update``, with the arrays
+            # handed to it, the serial build ran 1.8x slower)
+            bm = b / m
+            v0 = a * vel[i, 0] + bm * (f0 + m * g0)
+            v1 = a * vel[i, 1] + bm * (f1 + m * g1)
+            v2 = a * vel[i, 2] + bm * (f2 + m * g2)
+            bi = b / inertia[i]
+            w0 = a * omega[i, 0] + bi * t0
+            w1 = a * omega[i, 1] + bi * t1
+            w2 = a * omega[i, 2] + bi * t2
+            x0 = pos[i, 0] + v0 * dt
+            x1 = pos[i, 1] + v1 * dt
+            x2 = pos[i, 2] + v2 * dt
+            vel[i, 0] = v0
+            vel[i, 1] = v1
+            vel[i, 2] = v2
+            omega[i, 0] = w0
+            omega[i, 1] = w1
+            omega[i, 2] = w2
+            pos[i, 0] = x0
+            pos[i, 1] = x1
+            pos[i, 2] = x2
+        else:
+            _update(pos, vel, omega, i, f0 + m * g0, f1 + m * g1, f2 + m * g2, t0, t1,
+                    t2, m, inertia[i], fx, a, b, local, dt)
+        if wrap:
             for k in range(3):
-                dk = min_image(pos[i, k] - ref_pos[i, k], length[k], periodic[k])
-                dd += dk * dk
-            g = radius[i] - ref_radius[i]
-            if g > 0.0:
-                dg = np.sqrt(dd) + g
-                if dg > dmax:
-                    dmax = dg
-            elif dd > dmax2:
-                dmax2 = dd
-        dmove = np.sqrt(dmax2)
-        drift[blk] = dmax if dmax > dmove else dmove
+                if periodic[k]:
+                    x = pos[i, k] - lo[k]
+                    if x < 0.0 or x >= length[k]:
+                        x -= length[k] * np.floor(x / length[k])
+                        if x >= length[k]:
+                            x -= length[k]
+                        pos[i, k] = lo[k] + x
+        # drift_of without a square root per particle: sqrt is monotonic, so the
+        # largest move is the root of the largest squared move (growth kept apart)
+        dd = 0.0
+        for k in range(3):
+            dk = min_image(pos[i, k] - ref_pos[i, k], length[k], periodic[k])
+            dd += dk * dk
+        g = radius[i] - ref_radius[i]
+        if g > 0.0:
+            dg = np.sqrt(dd) + g
+            if dg > dmax:
+                dmax = dg
+        elif dd > dmax2:
+            dmax2 = dd
+    dmove = np.sqrt(dmax2)
+    drift[blk] = dmax if dmax > dmove else dmove
 
 
 def rayleigh_step(radius: float | np.ndarray, density: float | np.ndarray, shear_modulus: float,
