@@ -206,8 +206,8 @@ def _wall_normal_forces(c):  # pragma: no cover - numba
 def _pairs_update(pos, vel, omega, radius, mass, inertia, mat, fixed, start, pair_i, pair_j,
                   rev_start, rev_pair, hist, pairtab, elin, length, periodic, dim, thickness,
                   dt, fpair, tpair_i, tpair_j, pinfo, force, torque, wstart, wforce, wtorque,
-                  gravity, viscous, local, ref_pos, ref_radius, lo, drift,
-                  bounds):  # pragma: no cover - numba
+                  gravity, viscous, local, has_ext, ext_force, ext_torque, ref_pos,
+                  ref_radius, lo, drift, bounds):  # pragma: no cover - numba
     """The threaded loop's second pass (after ``pair_forces_cross`` and the walls; no
     interactions), one threaded region: each thread takes its ``BLOCKS_PER_THREAD`` blocks
     of ``bounds`` (``pair_block_bounds``; the cuts between threads fall between update
@@ -230,9 +230,9 @@ def _pairs_update(pos, vel, omega, radius, mass, inertia, mat, fixed, start, pai
         end = bounds[(t + 1) * BLOCKS_PER_THREAD]
         for blk in range((first + BLOCK - 1) // BLOCK, (end + BLOCK - 1) // BLOCK):
             advance_block(pos, vel, omega, radius, mass, inertia, fixed, wstart, wforce,
-                          wtorque, dt, gravity, viscous, local, False, force, torque,
-                          force, torque, ref_pos, ref_radius, lo, length, periodic, drift,
-                          blk)
+                          wtorque, dt, gravity, viscous, local, has_ext, ext_force,
+                          ext_torque, force, torque, ref_pos, ref_radius, lo, length,
+                          periodic, drift, blk)
 
 
 @numba.njit(cache=True)
@@ -242,11 +242,11 @@ def _run_steps(c, states, nmax, step0, check_every, max_ratio, bounds, xpairs,
     operations and order as the Python loop, so the same bits): pair contacts -> the
     interactions' compiled steps (``states``, in order) -> wall pass and the walls'
     totals -> particle update -> wall motion -> clock (threaded, without interactions:
-    cross pairs -> walls -> ``_pairs_update``, the same values). The first step starts at once (the
-    caller has just checked the neighbour list); before each later one the rebuild test
-    runs and, if due, the loop stops. After every step whose count (from ``step0``) is a
-    multiple of ``check_every`` the stability test runs (``_unstable``) and stops the
-    loop if it fails. ``bounds``: ``None`` (a compile-time branch) runs every kernel's
+    cross pairs -> walls -> ``_pairs_update``, the same values). The first step starts at
+    once (the caller has just checked the neighbour list); before each later one the
+    rebuild test runs and, if due, the loop stops. After every step whose count (from
+    ``step0``) is a multiple of ``check_every`` the stability test runs (``_unstable``) and
+    stops the loop if it fails. ``bounds``: ``None`` (a compile-time branch) runs every kernel's
     serial build; an array runs their threaded builds, the pairs in those blocks
     (``contact.pair_block_bounds``) with the pairs across them in ``xpairs[:nx[0]]``
     (``contact.pair_cross_list``), both cut again every ``REBALANCE_EVERY`` steps, in place,
@@ -290,7 +290,8 @@ def _run_steps(c, states, nmax, step0, check_every, max_ratio, bounds, xpairs,
                           c.pairtab, c.elin, c.length, c.periodic, c.dim, c.thickness, c.dt,
                           c.fpair, c.tpair_i, c.tpair_j, c.pinfo, c.force, c.torque,
                           c.wstart, c.wforce, c.wtorque, c.gravity, c.viscous, c.local,
-                          c.ref_pos, c.ref_radius, c.lo, c.drift, bounds)
+                          c.has_ext, c.ext_force, c.ext_torque, c.ref_pos, c.ref_radius,
+                          c.lo, c.drift, bounds)
         else:
             if c.dim == 2:
                 _pairs_2d(c.pos, c.vel, c.omega, c.radius, c.mass, c.inertia, c.mat,
