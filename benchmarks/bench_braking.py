@@ -1,11 +1,11 @@
-"""CPU time per step of the braking cell's sliding loop (issue 16), without the run's I/O.
+"""CPU time per step of the braking cell's sliding loop, without the run's I/O.
 
 Builds the interface of ``tribodem braking run --condition 5`` (``--quick``: the quick
-cell), starts the sliding and the braking loop's interaction, warms the kernels up for
-200 steps, then times ``--steps`` steps with ``time.process_time`` and prints one JSON
-line: particles, bonds, listed pairs, neighbour builds, CPU us per step and a checksum of
-the positions (the sum of all coordinates: equal checksums = the same trajectory, to
-check that a change leaves the results bitwise alone).
+cell), starts the sliding and the braking loop's drive (``SlidingDrive``), warms the
+kernels up for 200 steps, then times ``--steps`` steps with ``time.process_time`` and
+prints one JSON line: particles, bonds, listed pairs, neighbour builds, CPU us per step
+and a checksum of the positions (the sum of all coordinates: equal checksums = the same
+trajectory, to check that a change leaves the results bitwise alone).
 
     .venv/bin/python benchmarks/bench_braking.py --steps 20000
     PYTHONPATH=/path/to/other/tree .venv/bin/python benchmarks/bench_braking.py  # A/B
@@ -17,8 +17,8 @@ import argparse
 import json
 import time
 
-from tribodem.braking import run as braking_run
-from tribodem.braking.cli import _config, setup_from_config
+from tribodem.braking.config import resolve_config, setup_from_config
+from tribodem.braking.drive import SlidingDrive
 from tribodem.braking.model import build_interface, start_sliding
 
 
@@ -29,12 +29,12 @@ def main() -> None:
     ap.add_argument("--condition", type=int, default=5, help="table 4 condition (default 5)")
     ap.add_argument("--quick", action="store_true", help="the --quick cell")
     a = ap.parse_args()
-    s = setup_from_config(_config(a.condition, None, a.quick))
+    s = setup_from_config(resolve_config(condition=a.condition, quick=a.quick))
     iface = build_interface(s.geometry, s.pressure_Pa, s.micro, s.wall_mass_ratio,
                             s.dt_safety, s.local_damping, s.backing, s.plate_areal_mass)
     start_sliding(iface, s.speed_m_s)
     sim = iface.sim
-    sim.add_interaction(braking_run._Loop(iface, 0, 0, s.speed_m_s))
+    sim.add_interaction(SlidingDrive(iface, 0, 0, s.speed_m_s))
     sim.step(200)  # kernels compiled or loaded, first neighbour builds
     c0 = time.process_time()
     sim.step(a.steps)

@@ -32,16 +32,18 @@ from tribodem.braking.model import (
     LOOSE_MAX,
     PAD,
     Geometry,
-    _pairs_periodic,
     build_interface,
     compact_periodic,
     materials,
+    pairs_periodic,
     plate_force,
     profile_height,
     rough_profile,
     start_sliding,
 )
-from tribodem.braking.run import RunSetup, run_braking, wear_extrapolation
+from tribodem.braking.setup import RunSetup
+from tribodem.braking.simulate import run_braking
+from tribodem.braking.steady import wear_extrapolation
 from tribodem.dem.bonds import TENSILE
 from tribodem.dem.state import FIX_X, FIX_Y
 
@@ -263,7 +265,7 @@ def test_feed_continues_a_body_without_a_seam(body: str) -> None:
     # the block's own bonded pairs, periodic in y: those across its period boundary
     # between the body's particles in the cell and the band the slab came from
     gap = max(iface.disc.bond_gap, iface.pad.bond_gap)
-    i, j, _ = _pairs_periodic(blk.pos, blk.radius, blk.width, gap, height=blk.height)
+    i, j, _ = pairs_periodic(blk.pos, blk.radius, blk.width, gap, height=blk.height)
     cross = np.abs(blk.pos[j, 1] - blk.pos[i, 1]) > 0.5 * blk.height
     ids = {tuple(q): k for k, q in enumerate(blk.pos)}
     in_body = np.zeros(blk.radius.size, dtype=bool)
@@ -409,15 +411,15 @@ def test_a_tall_cell_is_compacted_until_jammed() -> None:
     nominal relaxations leaves 17 % of its particles without a neighbour within the bond
     gap; ``compact_periodic`` makes it again with longer relaxations until at most
     LOOSE_MAX are. A packing jammed at once (packing 0) is the one-pass packing, bitwise."""
-    from tribodem.braking.model import _compact_once
+    from tribodem.braking.model import compact_once
 
     disc, _ = materials("calibrated")
-    loose = _compact_once(disc, 100e-6, 300e-6, 4, 1e6, 40, disc.bond_gap, 1)[2]
+    loose = compact_once(disc, 100e-6, 300e-6, 4, 1e6, 40, disc.bond_gap, 1)[2]
     assert loose["loose_fraction"] > 3 * LOOSE_MAX
     _, _, stats = compact_periodic(disc, 100e-6, 300e-6, seed=4)
     assert stats["loose_fraction"] <= LOOSE_MAX and stats["relax_scale"] >= 2, stats
     pos, r, st0 = compact_periodic(disc, 100e-6, 300e-6, seed=0)
-    once = _compact_once(disc, 100e-6, 300e-6, 0, 1e6, 40, disc.bond_gap, 1)
+    once = compact_once(disc, 100e-6, 300e-6, 0, 1e6, 40, disc.bond_gap, 1)
     assert st0["relax_scale"] == 1 and np.array_equal(pos, once[0])
     assert np.array_equal(r, once[1])
 
@@ -575,15 +577,15 @@ def test_resume_in_process_equals_the_uninterrupted_run(tmp_path: Path,
     run is interrupted at sample 12, after the feed's checkpoint, and the resume replays
     the feed before loading it."""
     import tribodem.braking.feed as feed_mod
-    import tribodem.braking.run as run_mod
-    from tribodem.braking.run import read_checkpoint
+    import tribodem.braking.loop as loop_mod
+    from tribodem.braking.checkpoint import read_checkpoint
 
     monkeypatch.setattr(feed_mod, "FEED_SLAB_DIAMETERS", 1.0)
     full = run_braking(_tiny(change), tmp_path / "a")
     if change:
         assert full["ejected_particles_disc"] + full["ejected_particles_pad"] > 0
     stop = 12 if change.get("feed") else 8
-    real = run_mod.measure
+    real = loop_mod.measure
     calls = [0]
 
     def interrupted(*a: object, **k: object) -> dict:
@@ -592,10 +594,10 @@ def test_resume_in_process_equals_the_uninterrupted_run(tmp_path: Path,
             raise KeyboardInterrupt
         return real(*a, **k)
 
-    monkeypatch.setattr(run_mod, "measure", interrupted)
+    monkeypatch.setattr(loop_mod, "measure", interrupted)
     with pytest.raises(KeyboardInterrupt):
         run_braking(_tiny(change), tmp_path / "b")
-    monkeypatch.setattr(run_mod, "measure", real)
+    monkeypatch.setattr(loop_mod, "measure", real)
     rec = read_checkpoint(tmp_path / "b" / "checkpoint.npz")
     assert 0 < rec["done"] < rec["total_steps"] and not rec["finished"]
     if change.get("feed"):
@@ -617,13 +619,14 @@ def test_resume_in_process_equals_the_uninterrupted_run(tmp_path: Path,
 
 def test_instability_keeps_rows_and_a_stopped_summary(tmp_path: Path,
                                                       monkeypatch: pytest.MonkeyPatch) -> None:
+    from tribodem.braking.drive import SlidingDrive
     from tribodem.dem import Simulation, SimulationUnstable
 
     real = Simulation.step
     calls = [0]
 
     def unstable(self: Simulation, n: int = 1) -> None:
-        sliding = any(type(x).__name__ == "_Loop" for x in self.interactions)
+        sliding = any(isinstance(x, SlidingDrive) for x in self.interactions)
         calls[0] += sliding
         if sliding and calls[0] == 4:
             raise SimulationUnstable("particle 7 moved more than its radius in one step")
@@ -662,27 +665,32 @@ def test_a_worn_through_body_stops_the_run(tmp_path: Path) -> None:
         {k: v for k, v in s.items() if not k.startswith("wall_time")}
     never = run_braking(_tiny({"worn_through_diameters": 0.0}), None)
     assert never["status"] == "finished" and never["worn_through"] is None
-    from tribodem.braking.cli import RunCfg
-    from tribodem.braking.run import WORN_THROUGH
+    from tribodem.braking.config import RunCfg
+    from tribodem.braking.setup import WORN_THROUGH
 
     assert RunCfg().worn_through_diameters == WORN_THROUGH  # the command's default
 
 
 def test_quick_preset_overrides_the_config_file(tmp_path: Path) -> None:
-    from tribodem.braking.cli import QUICK, _config
+    from tribodem.braking.config import BrakingConfig, resolve_config
 
+    quick = BrakingConfig.quick()
     cfg = tmp_path / "c.toml"
     cfg.write_text("[run]\nduration_s = 1e-6\nsamples = 7\n[condition]\nindex = 2\n")
-    c = _config(None, cfg, quick=False)
+    c = resolve_config(cfg)
     assert c.run.duration_s == 1e-6 and c.run.samples == 7
-    q = _config(4, cfg, quick=True)  # defaults < file < --quick < --condition
-    assert q.run.duration_s == QUICK["run"]["duration_s"]
-    assert q.run.samples == QUICK["run"]["samples"] and q.condition.index == 4
-    assert _config(None, None, quick=True).run.samples == QUICK["run"]["samples"]
+    q = resolve_config(cfg, condition=4, quick=True)  # defaults < file < quick < condition
+    assert q.run.duration_s == quick["run"]["duration_s"]
+    assert q.run.samples == quick["run"]["samples"] and q.condition.index == 4
+    assert resolve_config(quick=True).run.samples == quick["run"]["samples"]
+    # a dict and a model resolve as the file does
+    assert resolve_config({"run": {"duration_s": 1e-6, "samples": 7},
+                           "condition": {"index": 2}}) == c
+    assert resolve_config(c, quick=True, condition=4) == q
 
 
 def test_steady_state_rule() -> None:
-    from tribodem.braking.run import STEADY_CUTS, steady_state
+    from tribodem.braking.steady import STEADY_CUTS, steady_state
 
     s = np.linspace(0.0, 3e-4, 31)
     h = np.where(s < 1e-4, 0.2 * s, 2e-5 + 0.05 * (s - 1e-4))  # fast run-in, then steady
@@ -716,8 +724,9 @@ def test_until_steady_with_a_load_ramp_resumes_bitwise(tmp_path: Path,
     after its first extension
     and resumed: bitwise the uninterrupted run; the summary reports the steady-state and
     contact fields."""
-    import tribodem.braking.run as run_mod
-    from tribodem.braking.run import read_checkpoint
+    import tribodem.braking.loop as loop_mod
+    import tribodem.braking.summary as summary_mod
+    from tribodem.braking.checkpoint import read_checkpoint
 
     change = {"duration_s": 0.5e-6, "samples": 10, "vtk_snapshots": 0, "until_steady": True,
               "steady_tolerance": 1e-9, "max_distance_m": 47.12 * 0.8e-6, "ramp_s": 0.75e-6,
@@ -729,11 +738,11 @@ def test_until_steady_with_a_load_ramp_resumes_bitwise(tmp_path: Path,
     notes = full["assumptions"]
     assert any(a.startswith("steady-state rule not passed") for a in notes)
     assert any(a.startswith("interface in contact") for a in notes) == (
-        full["contact_fraction"] < run_mod.CLOSED_CONTACT)
+        full["contact_fraction"] < summary_mod.CLOSED_CONTACT)
     for k in ("wear_rate_steady_m_per_m", "run_in_distance_m", "run_in_depth_m",
               "interface_load_ratio_mean", "sliding_distance_cap_m"):
         assert k in full
-    real = run_mod.measure
+    real = loop_mod.measure
     calls = [0]
 
     def interrupted(*a: object, **k: object) -> dict:
@@ -742,10 +751,10 @@ def test_until_steady_with_a_load_ramp_resumes_bitwise(tmp_path: Path,
             raise KeyboardInterrupt
         return real(*a, **k)
 
-    monkeypatch.setattr(run_mod, "measure", interrupted)
+    monkeypatch.setattr(loop_mod, "measure", interrupted)
     with pytest.raises(KeyboardInterrupt):
         run_braking(_tiny(change), tmp_path / "b")
-    monkeypatch.setattr(run_mod, "measure", real)
+    monkeypatch.setattr(loop_mod, "measure", real)
     rec = read_checkpoint(tmp_path / "b" / "checkpoint.npz")
     assert rec["min_steps"] < rec["done"] < rec["cap_steps"] and not rec["finished"]
     res = run_braking(_tiny(change), tmp_path / "b", resume=True)
@@ -757,37 +766,37 @@ def test_until_steady_with_a_load_ramp_resumes_bitwise(tmp_path: Path,
 
 
 def test_braking_example_configs_resolve() -> None:
-    from tribodem.braking.cli import _config, setup_from_config
+    from tribodem.braking.config import resolve_config, setup_from_config
 
     root = Path(__file__).resolve().parents[1] / "examples"
     for name in ("braking_steady.toml", "braking_wide.toml", "braking_outlet.toml",
                  "braking_feed.toml"):
-        s = setup_from_config(_config(5, root / name, False))
+        s = setup_from_config(resolve_config(root / name, condition=5))
         assert s.until_steady and s.max_distance_m > 0, name
-    assert setup_from_config(_config(5, root / "braking_feed.toml", False)).feed
-    assert setup_from_config(_config(5, root / "braking_outlet.toml", False)
+    assert setup_from_config(resolve_config(root / "braking_feed.toml", condition=5)).feed
+    assert setup_from_config(resolve_config(root / "braking_outlet.toml", condition=5)
                              ).outlet_length_m == pytest.approx(216e-6)
     # a fixed sliding distance: each condition slides 12 mm at its own speed (table 4)
     for cond, speed in ((5, 47.12), (3, 31.41)):
-        s = setup_from_config(_config(cond, root / "braking_saturated.toml", False))
+        s = setup_from_config(resolve_config(root / "braking_saturated.toml", condition=cond))
         assert s.duration_s * s.speed_m_s == pytest.approx(12e-3, rel=1e-12)
         assert s.speed_m_s == pytest.approx(speed, rel=1e-3)
     # --quick overrides the file's distance (the quick preset's own duration)
-    q = setup_from_config(_config(5, root / "braking_saturated.toml", True))
+    q = setup_from_config(resolve_config(root / "braking_saturated.toml", condition=5, quick=True))
     assert q.duration_s == pytest.approx(20e-6)
 
 
 def test_comparison_says_whether_time_or_distance_was_fixed() -> None:
     """A sweep at a fixed time says so (the seed's way); one at a fixed distance
     (``[run] distance_m``, so the times differ with the speed) says that instead."""
-    from tribodem.braking.compare import _length_text
+    from tribodem.braking.compare import length_text
 
     same_t = {1: {"simulated_time_s": 4e-5, "simulated_sliding_distance_m": 1.885e-3},
               3: {"simulated_time_s": 4e-5, "simulated_sliding_distance_m": 1.256e-3}}
-    assert "same braking time" in _length_text(same_t, 4e-5)
+    assert "same braking time" in length_text(same_t, 4e-5)
     same_d = {1: {"simulated_time_s": 2.55e-4, "simulated_sliding_distance_m": 12e-3},
               3: {"simulated_time_s": 3.82e-4, "simulated_sliding_distance_m": 12e-3}}
-    text = _length_text(same_d, 2.55e-4)
+    text = length_text(same_d, 2.55e-4)
     assert "12 mm" in text and "same sliding distance" in text and "255-382 us" in text
 
 

@@ -8,7 +8,8 @@ from analytic_backend import AnalyticHertzSolver
 
 from tribodem.contact import BACKENDS
 from tribodem.fretting import ALPHA_SEED, CriterionUnavailable, FrettingLoop, make_criterion
-from tribodem.fretting.cli import build_loop, resolve_config
+from tribodem.fretting.case import build_loop
+from tribodem.fretting.config import resolve_config
 from tribodem.io.config import ConfigError
 
 LOAD, MU, AMP = 100.0, 0.6, 0.3e-3

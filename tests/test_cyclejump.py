@@ -1,4 +1,4 @@
-"""Cycle-jumping strategies (issue 4; seed 003 chapter 4)."""
+"""Cycle-jumping strategies (seed 003 chapter 4)."""
 
 from __future__ import annotations
 
@@ -346,7 +346,7 @@ def test_adaptive_total_decides_on_the_sum_of_an_array_state() -> None:
         AdaptiveJump(decide_on="mean")
 
 
-# --- issue 13: step control follows the curve's smoothness ------------------------------
+# --- step control follows the curve's smoothness ---------------------------------------
 
 SMOOTH_N = 3000
 SMOOTH_NOISE_SEEDS = range(3)
@@ -391,7 +391,7 @@ def test_error_controlled_jump_formula():
 
 @pytest.mark.parametrize("shape, noise, seed", list(smooth_cases()))
 def test_adaptive_default_saves_60_percent_on_smooth_shapes(shape, noise, seed):
-    """Acceptance (issue 13 item 6): >= 60 % saved at <= 5 % final error on every shape."""
+    """Acceptance: >= 60 % saved at <= 5 % final error on every shape."""
     c, inc = synthetic_smooth_series(shape, n=SMOOTH_N, noise=noise, seed=seed)
     r = replay(AdaptiveJump(), c, inc)
     assert r.cycles_saved_fraction >= 0.60, r.summary()

@@ -1,4 +1,4 @@
-"""``tribodem jump replay`` (issue 4): output, plot, and refusal of bad CSVs (exit 2)."""
+"""``tribodem jump replay``: output, plot, and refusal of bad CSVs (exit 2)."""
 
 from __future__ import annotations
 
@@ -12,7 +12,8 @@ import pytest
 from typer.testing import CliRunner
 
 from tribodem.cyclejump import synthetic_two_phase_series
-from tribodem.cyclejump.cli import jump_app, parse_params, read_increments_csv
+from tribodem.cyclejump.cli import jump_app, parse_params
+from tribodem.cyclejump.recorded import read_increments_csv
 from tribodem.io.config import ConfigError
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -129,9 +130,9 @@ def test_bad_options_exit_2(args, msg):
 
 
 @pytest.mark.parametrize("args, msg", [
-    (["--strategy", "adaptive", "--param", "q_y=abc"], "expected float"),
-    (["--strategy", "adaptive", "--param", "degree=2.5"], "expected int"),
-    (["--strategy", "adaptive", "--param", "taylor_order=3"], "taylor_order must be"),
+    (["--strategy", "polynomial", "--param", "q_y=abc"], "expected float"),
+    (["--strategy", "polynomial", "--param", "degree=2.5"], "expected int"),
+    (["--strategy", "polynomial", "--param", "taylor_order=3"], "taylor_order must be"),
     (["--strategy", "constant", "--param", "jump_length"], "expected key=value"),
     (["--strategy", "moving", "--param", "moving_window=1"], "not a parameter"),
 ])
@@ -148,7 +149,7 @@ def test_missing_input_file_exit_2(tmp_path):
 
 
 def test_parse_params_types():
-    assert parse_params("adaptive", ["degree_late=none", "moving_window=false",
+    assert parse_params("polynomial", ["degree_late=none", "moving_window=false",
                                      "q_e=0.01", "max_jump_initial=15"]) == {
         "degree_late": None, "moving_window": False, "q_e": 0.01, "max_jump_initial": 15}
     with pytest.raises(ConfigError):

@@ -9,7 +9,7 @@ from typing import Any
 import numpy as np
 import pytest
 
-from tribodem.braking import run as braking_run
+from tribodem.braking.drive import SlidingDrive
 from tribodem.braking.model import Geometry, build_interface, start_sliding
 from tribodem.dem import Box, Material, ParticleState, PlaneWall, Simulation, SimulationUnstable
 from tribodem.dem.bonds import install_bonds_by_gap
@@ -133,7 +133,7 @@ def test_braking_pieces_compiled_equal_python() -> None:
     for fast in (True, False):
         it = build_interface(geo, 20e6)  # a high load: contact within 2,000 steps
         start_sliding(it, 47.0)
-        loop = braking_run._Loop(it, 0, 0, 47.0)
+        loop = SlidingDrive(it, 0, 0, 47.0)
         it.sim.add_interaction(loop)
         it.sim.compiled_loop = fast
         assert (it.sim._compiled_states() is not None) == fast

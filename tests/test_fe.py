@@ -9,6 +9,7 @@ import math
 import shutil
 import sys
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -43,9 +44,9 @@ needs_ccx = pytest.mark.skipif(shutil.which("ccx") is None,
 COARSE = 0.25  # element size at the contact / a
 
 
-def coarse_case(**kw: object) -> LineCase:
+def coarse_case(**kw: Any) -> LineCase:
     return LineCase(load=1e5, delta=3e-6, n_increments=32, half_cycle=True,
-                    h_over_a=COARSE, **kw)  # type: ignore[arg-type]
+                    h_over_a=COARSE, **kw)
 
 
 # --- no solver needed -------------------------------------------------------------------------

@@ -36,6 +36,7 @@ import pytest
 from conftest import run_tribodem
 
 from tribodem.contact import ElasticBody, contact_modulus
+from tribodem.contact.base import ContactCase
 from tribodem.contact.fe import PadOnFlat, cylinder_on_flat, hertz_line
 from tribodem.contact.fe.backend import FEContactSolver, cell_average
 from tribodem.contact.fe.ccx import INSTALL_COMMAND
@@ -46,8 +47,10 @@ from tribodem.contact.fe.mesh import (
     surface_projection,
     worn_area,
 )
+from tribodem.contact.fe.options import FEOptions
 from tribodem.contact.fe.results import tributary_length
 from tribodem.contact.fe.validate import half_width_fit
+from tribodem.contact.geometry import cylinder, flat
 
 needs_ccx = pytest.mark.skipif(shutil.which("ccx") is None,
                                reason=f"CalculiX ccx not on PATH ({INSTALL_COMMAND})")
@@ -230,19 +233,19 @@ def test_a_backend_keeps_its_last_attempt_across_a_resume(tmp_path: Path) -> Non
     resumed run starts where the uninterrupted one would); a state saved before that was
     kept takes it from the run's ``jobs.csv`` (its last row's refine and penalty scale);
     ``retry_from = "first"`` always starts at the configured job."""
-    from fe3d_cases import _solver
+    from fe3d_cases import fe3d_solver
 
     from tribodem.contact.fe import jobs
 
-    s = _solver(tmp_path, retries=4, retry_from="last")
+    s = fe3d_solver(tmp_path, retries=4, retry_from="last")
     assert s._first_attempt() == 0
     s._last_attempt = 4
     assert s._first_attempt() == 4
     state = s.state_dict()
-    other = _solver(tmp_path / "b", retries=3, retry_from="last")
+    other = fe3d_solver(tmp_path / "b", retries=3, retry_from="last")
     other.load_state_dict(state)
     assert other._first_attempt() == 3  # no further than its own retries
-    first = _solver(tmp_path / "c", retries=4)
+    first = fe3d_solver(tmp_path / "c", retries=4)
     first.load_state_dict(state)
     assert first._last_attempt == 4 and first._first_attempt() == 0
     old = {k: v for k, v in state.items() if k != "last_attempt"}
@@ -250,11 +253,11 @@ def test_a_backend_keeps_its_last_attempt_across_a_resume(tmp_path: Path) -> Non
     row = dict.fromkeys(jobs.JOB_COLUMNS, "0") | {"refine": "4", "penalty_scale": "0.5"}
     jobs.write_csv(tmp_path / "d" / "jobs.csv", jobs.JOB_COLUMNS, [list(row.values())])
     old["workdir"] = str(tmp_path / "d")
-    older = _solver(None, retries=4, retry_from="last")
+    older = fe3d_solver(None, retries=4, retry_from="last")
     older.load_state_dict(old)
     assert older._first_attempt() == 3
     with pytest.raises(ValueError, match="retry_from = 'middle' is not allowed"):
-        _solver(tmp_path / "e", retry_from="middle")
+        fe3d_solver(tmp_path / "e", retry_from="middle")
 
 
 def test_a_failed_deck_is_not_run_again(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
@@ -318,11 +321,20 @@ def test_cell_average_conserves_the_integral() -> None:
 AMPLITUDE = 10e-6  # m: gross slip is reached at about 3 um (docs/fe.md)
 
 
+def line_case(load: float = LOAD * WINDOW, n: int = 64) -> ContactCase:
+    """The EN24T cylinder R 4 mm on a flat, mu 0.6, on a window of 10 half-widths (``load``
+    N on it), +-10 um in 4 increments."""
+    return ContactCase(upper=cylinder(8e-3, axis="y"), lower=flat(),
+                       upper_material=ElasticBody(), lower_material=ElasticBody(), load=load,
+                       friction=0.6, amplitude=AMPLITUDE, n_increments=4, n=n, window=WINDOW,
+                       contact="line")
+
+
 @pytest.fixture(scope="module")
 def served(tmp_path_factory: pytest.TempPathFactory):  # noqa: ANN201
-    solver = FEContactSolver(load=LOAD * WINDOW, window=WINDOW, n=128, amplitude=AMPLITUDE,
-                             n_increments=4, h_over_a=0.25, size_factor=40, threads=1,
-                             timeout=600, workdir=tmp_path_factory.mktemp("fe_backend"))
+    solver = FEContactSolver(line_case(n=128),
+                             FEOptions(h_over_a=0.25, size_factor=40, threads=1, timeout=600),
+                             workdir=tmp_path_factory.mktemp("fe_backend"))
     solver.reset()
     loaded = solver.solve_increment(0.0)
     solver.begin_cycle()
@@ -585,9 +597,10 @@ def test_job_cache_serves_the_same_job_without_running_ccx(tmp_path: Path) -> No
     job, the second copies it (``cached``, no ccx time) and serves bitwise the same fields;
     a changed case (another load) is a different deck and runs."""
     def solve(load: float, name: str):  # noqa: ANN202
-        s = FEContactSolver(load=load * WINDOW, window=WINDOW, n=64, amplitude=AMPLITUDE,
-                            n_increments=4, h_over_a=0.5, size_factor=20, threads=1,
-                            timeout=600, workdir=tmp_path / name, cache=tmp_path / "cache")
+        s = FEContactSolver(line_case(load=load * WINDOW),
+                            FEOptions(h_over_a=0.5, size_factor=20, threads=1, timeout=600,
+                                      cache=str(tmp_path / "cache")),
+                            workdir=tmp_path / name)
         s.reset()
         loaded = s.solve_increment(0.0)
         s.begin_cycle()

@@ -17,7 +17,7 @@ Closed forms and tolerances (seed 003: EN24T crossed cylinders R = 4 mm, 100 N, 
 * the installed command ``tribodem fretting run --solver fe3d --quick`` runs a cycle and
   resumes for a second (2 ccx jobs), writing its results, jobs.csv and the decks.
 
-ccx budget on 1 thread (measured, docs/fe3d.md, BENCHMARKS.md "Session 39"): one h = a/3
+ccx budget on 1 thread (measured, docs/fe3d.md, BENCHMARKS.md): one h = a/3
 job (compact bodies 4 a, ``fe3d_cases.COMPACT``; +-10 um, 4 increments; 62 s with Debian's
 ccx, 131 s on bodies 6 a) shared by the Hertz and slip tests, and two h = a jobs for the
 command (the quick preset: +-0.3 mm, 64 ccx increments a cycle; ~56 s with Debian's ccx).
@@ -35,7 +35,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from conftest import run_tribodem
-from fe3d_cases import AMPLITUDE, COMPACT, LOAD, P0, A, _solver
+from fe3d_cases import AMPLITUDE, COMPACT, LOAD, P0, A, fe3d_case, fe3d_solver
 
 from tribodem.contact import ElasticBody
 from tribodem.contact.fe.backend3d import FE3DContactSolver, hex_volumes, mesh_columns
@@ -50,7 +50,7 @@ pytestmark = pytest.mark.skipif(shutil.which("ccx") is None,
 
 def test_morphing_worn_volume_is_exact(tmp_path: Path) -> None:
     """A paraboloid scar 3 elements wide, off the columns, through set_surfaces: its volume."""
-    solver = _solver(tmp_path)
+    solver = fe3d_solver(tmp_path)
     base_up, base_lo = crossed_cylinders()
     h = solver._mesh0.h_fine
     d0, b = 0.3 * h, 1.5 * h  # peak depth, radius (m), inside the fine zone and window
@@ -97,7 +97,7 @@ def test_a_slope_limited_morph_keeps_the_worn_volume(tmp_path: Path) -> None:
     base_up, base_lo = crossed_cylinders()
     meshes = {}
     for s in (None, 0.1):
-        solver = _solver(tmp_path / str(s), max_wear_slope=s)
+        solver = fe3d_solver(tmp_path / str(s), max_wear_slope=s)
         h = solver._mesh0.h_fine
         d0, b = 0.3 * h, 1.5 * h
 
@@ -120,7 +120,7 @@ def test_a_slope_limited_morph_keeps_the_worn_volume(tmp_path: Path) -> None:
     assert "max_wear_slope = 0.1" in plain._steepness_hint()
     assert limited._steepness_hint() == ""
     with pytest.raises(ValueError, match="max_wear_slope"):
-        _solver(tmp_path / "bad", max_wear_slope=0.0)
+        fe3d_solver(tmp_path / "bad", max_wear_slope=0.0)
 
 
 def test_deck_fields_fit_ccx(tmp_path: Path) -> None:
@@ -131,7 +131,7 @@ def test_deck_fields_fit_ccx(tmp_path: Path) -> None:
     retry's softer contact (``penalty_scale`` 1/2) halves the normal penalty and the stick
     slope and nothing else of them (mu, the tension)."""
     for n_inc, material in ((48, "elastic"), (12, "elastic-plastic"), (16, "elastic")):
-        solver = _solver(tmp_path, n_increments=n_inc, material=material)
+        solver = fe3d_solver(tmp_path, n_increments=n_inc, material=material)
         deck = solver.write_deck(tmp_path / f"job{n_inc}.inp", solver._mesh0, 1e-6)
         lines = deck.read_text().splitlines()
         data = [line for k, line in enumerate(lines)
@@ -167,7 +167,7 @@ def test_loading_friction_sets_the_seating_and_loading_coefficient(tmp_path: Pat
     for value, material, runs in (("low", "elastic", "low"), ("full", "elastic", "full"),
                                   ("auto", "elastic", "low"),
                                   ("auto", "elastic-plastic", "full")):
-        solver = _solver(tmp_path / value, loading_friction=value, material=material)
+        solver = fe3d_solver(tmp_path / value, loading_friction=value, material=material)
         assert solver.loading_friction == runs
         path = solver.write_deck(tmp_path / f"{value}.inp", solver._mesh0, 1e-6)
         lines = path.read_text().splitlines()
@@ -181,7 +181,7 @@ def test_loading_friction_sets_the_seating_and_loading_coefficient(tmp_path: Pat
     assert diff == [("0.001, " + diff[0][0].split(", ")[1], "0.6, " + diff[0][0].split(", ")[1])]
     assert decks["auto", "elastic"] == low
     with pytest.raises(ValueError, match="loading_friction = 'half' is not allowed"):
-        _solver(tmp_path / "bad", loading_friction="half")
+        fe3d_solver(tmp_path / "bad", loading_friction="half")
 
 
 def test_cycle_increments_cap_the_quarters_increments_only(tmp_path: Path) -> None:
@@ -192,7 +192,7 @@ def test_cycle_increments_cap_the_quarters_increments_only(tmp_path: Path) -> No
     the output times (``TQUARTER``), the seating or the loading; below 4 or not an integer
     is refused."""
     def quarters(**kw: float) -> tuple[list[float], list[str]]:
-        solver = _solver(tmp_path, n_increments=8, **kw)
+        solver = fe3d_solver(tmp_path, n_increments=8, **kw)
         lines = solver.write_deck(tmp_path / "job.inp", solver._mesh0, 1e-6).read_text()
         lines = lines.splitlines()
         static = [lines[k + 1] for k, line in enumerate(lines) if line == "*STATIC"]
@@ -212,7 +212,7 @@ def test_cycle_increments_cap_the_quarters_increments_only(tmp_path: Path) -> No
     assert quarters(cycle_increments=16, **plastic)[0] == [1 / 8] * 4
     for bad in (3, 8.5):
         with pytest.raises(ValueError, match=f"cycle_increments = {bad!r} is not allowed"):
-            _solver(tmp_path, cycle_increments=bad)
+            fe3d_solver(tmp_path, cycle_increments=bad)
 
 
 def test_quarters_start_at_a_quarter_of_the_mindlin_slip(tmp_path: Path) -> None:
@@ -233,11 +233,11 @@ def test_quarters_start_at_a_quarter_of_the_mindlin_slip(tmp_path: Path) -> None
     delta = 3.0 * 0.6 * LOAD * (2.0 - body.poisson) / (8.0 * body.shear * A)
     assert 3.1e-6 < delta < 3.2e-6  # the seed's case: 3.15 um
     amplitude = 0.3e-3
-    plastic = _solver(tmp_path / "p", amplitude=amplitude, n_increments=16,
+    plastic = fe3d_solver(tmp_path / "p", amplitude=amplitude, n_increments=16,
                       material="elastic-plastic")
     # (the solver's R comes from the surfaces' curvatures: a agrees to ~1e-6)
     assert plastic.gross_slip_displacement == pytest.approx(delta, rel=1e-5)
-    elastic = _solver(tmp_path / "e", amplitude=amplitude, n_increments=16)
+    elastic = fe3d_solver(tmp_path / "e", amplitude=amplitude, n_increments=16)
     for solver, name in ((plastic, "p.inp"), (elastic, "e.inp")):
         largest = 4.0 / (16 * solver.cycle_refine)
         for first, period, smallest, most in quarters(solver, name):
@@ -249,11 +249,12 @@ def test_fe3d_refuses_other_geometries(tmp_path: Path) -> None:
     from tribodem.contact.geometry import cylinder, flat
 
     with pytest.raises(ValueError, match="crossed cylinders"):
-        FE3DContactSolver(cylinder(8e-3, axis="y"), flat(), workdir=tmp_path)
+        FE3DContactSolver(fe3d_case(upper=cylinder(8e-3, axis="y"), lower=flat()),
+                          workdir=tmp_path)
     with pytest.raises(ValueError, match="size_factor"):
-        _solver(tmp_path, size_factor=40.0)
+        fe3d_solver(tmp_path, size_factor=40.0)
     with pytest.raises(ValueError, match="mode"):
-        _solver(tmp_path, mode="chained")
+        fe3d_solver(tmp_path, mode="chained")
 
 
 def test_fe_mesh_fields_left_out_are_each_backends_own_and_set_are_taken() -> None:
@@ -261,7 +262,7 @@ def test_fe_mesh_fields_left_out_are_each_backends_own_and_set_are_taken() -> No
     fe a/4, 40 a); set, they reach the backend as given, fe3d's 0.25 too (a/4; before
     config_version 2 it was read as fe3d's own a/3). The ccx time limit: the backend's own
     (4 h) unless set."""
-    from tribodem.fretting.cli import FrettingConfig, build_solver
+    from tribodem.fretting import FrettingConfig, build_solver
 
     own = build_solver(FrettingConfig.model_validate({"solver": "fe3d"}))
     assert (own.h_over_a, own.size_factor) == (pytest.approx(1 / 3), 8.0)
@@ -282,7 +283,7 @@ def test_an_old_default_fe3d_checkpoint_resumes_on_fe3ds_own_mesh() -> None:
     solver is built on a/3 and 8 a again."""
     from conftest import before_config_v2
 
-    from tribodem.fretting.cli import (
+    from tribodem.fretting import (
         FrettingConfig,
         build_solver,
         check_resume,
@@ -301,7 +302,7 @@ def test_an_old_default_fe3d_checkpoint_resumes_on_fe3ds_own_mesh() -> None:
 
 @pytest.fixture(scope="module")
 def served(tmp_path_factory: pytest.TempPathFactory):  # noqa: ANN201
-    solver = _solver(tmp_path_factory.mktemp("fe3d"), **COMPACT)
+    solver = fe3d_solver(tmp_path_factory.mktemp("fe3d"), **COMPACT)
     solver.reset()
     loaded = solver.solve_increment(0.0)
     solver.begin_cycle()
@@ -404,8 +405,8 @@ def test_subsurface_stress_on_the_axis(served) -> None:  # noqa: ANN001
 def test_quick_preset_runs_and_resumes(tmp_path: Path) -> None:
     """``tribodem fretting run --solver fe3d --quick`` (the seed's case on the quick fe3d
     preset: h = a, 8 increments) for one cycle, then ``--resume --cycles 2``, through the
-    installed command. The quick run stopped with exit 3 until session 22 (a 21-character
-    *STATIC field, then "too many cutbacks" at the first reversal); the second cycle's
+    installed command. The quick run once stopped with exit 3 (a 21-character *STATIC
+    field, then "too many cutbacks" at the first reversal); the second cycle's
     morphed mesh carries the loop's first-cycle volume (the projection, within 1 %). (The
     resumed run's results.csv was measured identical to an uninterrupted 2-cycle run's,
     docs/fe3d.md.)"""

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from fe3d_cases import AMPLITUDE, COMPACT, LOAD, P0, A, _solver
+from fe3d_cases import AMPLITUDE, COMPACT, LOAD, P0, A, fe3d_solver
 
 from tribodem.contact.fe.ccx import INSTALL_COMMAND
 from tribodem.contact.geometry import crossed_cylinders
@@ -36,7 +36,7 @@ def test_plastic_first_yield_under_the_surface(tmp_path: Path) -> None:
     y = EN24T.yield_strength
     for factor in (0.9, 1.2):
         load = LOAD * (factor * 1.60 * y / P0) ** 3  # p0 ~ P^(1/3)
-        solver = _solver(tmp_path / f"f{factor}", load=load, h_over_a=0.5,
+        solver = fe3d_solver(tmp_path / f"f{factor}", load=load, h_over_a=0.5,
                          material="elastic-plastic", plastic_increments=16, **COMPACT)
         assert solver.capabilities.plastic and not solver.capabilities.plastic_every_cycle
         solver.reset()
@@ -83,7 +83,7 @@ def test_debris_pressure_pushes_the_bodies_apart_and_is_conserved(tmp_path: Path
     half-space's with the same debris within 3 % (measured -0.6 %; -1.2 % on 6 a)."""
     from tribodem.contact.halfspace import HalfSpaceSolver
 
-    s = _solver(tmp_path, h_over_a=0.5, **WIDER)
+    s = fe3d_solver(tmp_path, h_over_a=0.5, **WIDER)
     up, lo = crossed_cylinders()
     hs = HalfSpaceSolver(up, lo, load=LOAD, n=64, window=s.window)
     a, c = s.hertz[1], s.coords
@@ -112,7 +112,7 @@ def test_debris_pressure_pushes_the_bodies_apart_and_is_conserved(tmp_path: Path
     for o in s.offsets:
         assert s.solve_increment(float(o)).normal_load == pytest.approx(0.8 * LOAD, rel=1e-3)
     assert len(s.jobs) == jobs  # the cycle reused the job the DE phase read
-    other = _solver(tmp_path / "other", h_over_a=0.5, **WIDER)
+    other = fe3d_solver(tmp_path / "other", h_over_a=0.5, **WIDER)
     other.load_state_dict(s.state_dict())
     np.testing.assert_array_equal(other.debris_pressure, pd)
     with pytest.raises(ValueError, match="debris load"):
@@ -125,7 +125,7 @@ def test_primed_mode_serves_the_steady_loop(tmp_path: Path) -> None:
     previous cycle's second half, and the served cycle dissipates the steady
     Mindlin-Deresiewicz loop 4 mu P (A - 0.8 delta*), 8.6 % more at A = 10 um, delta* =
     3 mu P (2 - nu) / (8 G a). Both within 2 % (measured -0.53 % and -0.51 % at h = a/2)."""
-    s = _solver(tmp_path, h_over_a=0.5, mode="primed")
+    s = fe3d_solver(tmp_path, h_over_a=0.5, mode="primed")
     g = 240e9 / (2 * 1.3)
     d_star = 3 * 0.6 * LOAD * (2 - 0.3) / (8 * g * A)
     s.reset()

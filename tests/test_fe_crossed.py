@@ -1,4 +1,4 @@
-"""3D crossed-cylinder model on CalculiX against Hertz (issue 14 item 2; Johnson eqs 4.22-4.23).
+"""3D crossed-cylinder model on CalculiX against Hertz (Johnson eqs 4.22-4.23).
 
 A coarse quarter model (h = a/4, bodies 6 a): peak pressure and contact radius within 2 %,
 the contact force equal to the load. The half model with friction (Mindlin, gross slip) is in

@@ -1,4 +1,4 @@
-"""Fretting wear loop (issue 5): criteria, column search, geometry update, jumping, CLI."""
+"""Fretting wear loop: criteria, column search, geometry update, jumping, CLI."""
 
 from __future__ import annotations
 
@@ -21,7 +21,8 @@ from tribodem.fretting import (
     column_search,
     make_criterion,
 )
-from tribodem.fretting.cli import FrettingConfig, build_loop, resolve_config
+from tribodem.fretting.case import build_loop
+from tribodem.fretting.config import FrettingConfig, resolve_config
 from tribodem.io.config import ConfigError
 
 ROOT = Path(__file__).resolve().parents[1]

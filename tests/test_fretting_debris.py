@@ -140,7 +140,7 @@ def test_coupled_loop_conserves_mass_and_shares_load() -> None:
 
 
 def test_quick_coupled_cli_run(tmp_path) -> None:
-    """`tribodem fretting run --quick --cycles 3 --debris-every 2`: the issue's outputs."""
+    """`tribodem fretting run --quick --cycles 3 --debris-every 2`: the debris outputs."""
     import csv
     import json
 

@@ -1,4 +1,4 @@
-"""Seed 003 section 5.4 debris study (`tribodem fretting debris-study`), issue 13 item 7.
+"""Seed 003 section 5.4 debris study (`tribodem fretting debris-study`).
 
 Closed forms: the centre / edge zones and their mean pressures on a Hertz distribution;
 equilibrium (solid + debris force on the lower body = the applied load) and the imposed
@@ -15,7 +15,7 @@ import numpy as np
 from conftest import run_tribodem
 
 from tribodem.fretting.debris import DebrisSettings
-from tribodem.fretting.debris_study import contact_zones, distribution_metrics, place_debris
+from tribodem.fretting.debris_counts import contact_zones, distribution_metrics, place_debris
 
 
 def _hertz(n: int = 512, a_cells: float = 120.0) -> tuple[np.ndarray, np.ndarray, float]:

@@ -1,4 +1,4 @@
-"""Elastic-plastic solver (tamaas EPIC) and the DFDI / SWT criteria (issue 5, seed ch. 6)."""
+"""Elastic-plastic solver (tamaas EPIC) and the DFDI / SWT criteria (seed ch. 6)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Cycle-jumping in the fretting loop keeps the scar's shape (issue 13).
+"""Cycle-jumping in the fretting loop keeps the scar's shape.
 
 A long gross-slip Archard run (10,000 cycles, sphere on flat = crossed equal cylinders):
 the default jumped run (adaptive strategy, the loop's geometry control) saves >= 90% of the
@@ -80,10 +80,10 @@ def test_without_geometry_control_the_scar_is_wrong(reference) -> None:
 
 
 def test_default_jumping_keeps_a_line_contact_scar() -> None:
-    """The same on a cylinder on a flat (line contact, plane strain, periodic along the
-    cylinder; P' = 1e5 N/m, the default +-0.3 mm stroke), through the config as a user runs
-    it."""
-    from tribodem.fretting.cli import build_loop, resolve_config
+    """The same on a cylinder on a flat (line contact, plane strain, on one cross-section;
+    P' = 1e5 N/m, the default +-0.3 mm stroke), through the config as a user runs it."""
+    from tribodem.fretting.case import build_loop
+    from tribodem.fretting.config import resolve_config
 
     def line(jump: dict) -> tuple:  # noqa: ANN001
         cfg = resolve_config(None, overrides={
@@ -91,12 +91,12 @@ def test_default_jumping_keeps_a_line_contact_scar() -> None:
             "contact": {"geometry": "cylinder_on_flat", "load_per_length": 1e5, "n": 64,
                         "n_increments": 4, "tolerance": 1e-8}})
         h = build_loop(cfg).run(N)
-        prof = h.wear_upper[:, h.grid.n // 2]
+        prof = h.wear_upper[:, h.grid.ny // 2]
         return h, float(prof.max()), scar_width(prof, h.grid.dx)
 
     _, depth_ref, width_ref = line({"strategy": "constant", "params": {"jump_length": N // 100},
                                     "geometry_tolerance": 0})
     h, depth, width = line({"strategy": "adaptive"})
     assert h.cycles_simulated <= 0.1 * N
-    assert depth == pytest.approx(depth_ref, rel=0.05)  # measured +1.5%
-    assert width == pytest.approx(width_ref, rel=0.05)  # measured -0.6%
+    assert depth == pytest.approx(depth_ref, rel=0.05)  # measured -0.3 % (77 simulated)
+    assert width == pytest.approx(width_ref, rel=0.05)  # measured +0.1 %

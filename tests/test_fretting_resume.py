@@ -1,4 +1,4 @@
-"""``tribodem fretting run`` is resumable and honest (issue 11), through the installed command.
+"""``tribodem fretting run`` is resumable and honest, through the installed command.
 
 A run killed (SIGKILL) or interrupted (Ctrl-C) at a random point and continued with
 ``--resume`` writes the same results.csv and summary.json numbers as an uninterrupted run
@@ -21,7 +21,8 @@ import pytest
 from conftest import before_config_v2 as _before_v2
 from conftest import run_tribodem, tribodem_exe
 
-from tribodem.fretting.cli import resolve_config, run_fretting
+from tribodem.fretting.config import resolve_config
+from tribodem.fretting.runner import run
 from tribodem.io.config import merge
 from tribodem.io.runs import RunStopped
 
@@ -144,11 +145,11 @@ def _in_process(tmp: Path, monkeypatch: pytest.MonkeyPatch, name: str, cycles: i
                 extra: dict, stop_after: int) -> None:
     """Uninterrupted vs interrupted (Ctrl-C raised right after the ``stop_after``-th
     checkpoint, so the rest of that cycle's work is lost) and resumed (Python API)."""
-    import tribodem.fretting.cli as fcli
+    import tribodem.fretting.runner as fcli
 
-    ov = merge({"output": {"figures": False, "vtk": True}}, extra)
+    ov = merge({"output": {"figures": False, "vtk": True, "checkpoint_seconds": 0}}, extra)
     cfg = resolve_config(None, quick=True, overrides=merge(ov, {"cycles": cycles}))
-    run_fretting(cfg, tmp / f"{name}_a")
+    run(cfg, tmp / f"{name}_a")
     real, calls = fcli.write_checkpoint, []
 
     def interrupted(*args, **kw):  # noqa: ANN002, ANN003, ANN202
@@ -159,9 +160,9 @@ def _in_process(tmp: Path, monkeypatch: pytest.MonkeyPatch, name: str, cycles: i
 
     monkeypatch.setattr(fcli, "write_checkpoint", interrupted)
     with pytest.raises(KeyboardInterrupt):
-        run_fretting(cfg, tmp / f"{name}_b")
+        run(cfg, tmp / f"{name}_b")
     monkeypatch.undo()
-    run_fretting(cfg, tmp / f"{name}_b", resume=True)
+    run(cfg, tmp / f"{name}_b", resume=True)
     _same_outputs(tmp / f"{name}_a", tmp / f"{name}_b")
     for f in ("surface_upper.vtu", "surface_lower.vtu"):  # the wear maps
         assert (tmp / f"{name}_a" / f).read_bytes() == (tmp / f"{name}_b" / f).read_bytes()
@@ -169,7 +170,9 @@ def _in_process(tmp: Path, monkeypatch: pytest.MonkeyPatch, name: str, cycles: i
 
 @pytest.mark.parametrize(("jump", "cycles", "stop_after"), [
     ({"strategy": "constant", "params": {"jump_length": 3}}, 12, 2),
-    ({"strategy": "adaptive", "params": {"foundation_cycles": 4, "max_jump_initial": 4}},
+    ({"strategy": "polynomial", "params": {"foundation_cycles": 4, "max_jump_initial": 4}},
+     20, 5),
+    ({"strategy": "adaptive", "params": {"foundation_cycles": 6, "max_jump_initial": 4}},
      20, 5),
 ])
 def test_resume_with_jumping_equals_uninterrupted(tmp_path: Path,
@@ -252,7 +255,7 @@ def test_unknown_jump_param_refused(tmp_path: Path) -> None:
     out = tmp_path / "new"
     r = run_tribodem("fretting", "run", "--config", str(cfg), "--out", str(out), timeout=120)
     assert r.returncode == 2, r.stderr
-    assert "q_why" in r.stderr and "q_y" in r.stderr and "foundation_cycles" in r.stderr
+    assert "q_why" in r.stderr and "tol" in r.stderr and "foundation_cycles" in r.stderr
     assert not out.exists()
 
 
@@ -290,14 +293,14 @@ def test_python_api_early_stop_raises_run_stopped(tmp_path: Path) -> None:
     cfg = resolve_config(None, quick=True, overrides=merge(OUTGROWS, {
         "cycles": 8, "output": {"figures": False, "vtk": False}}))
     with pytest.raises(RunStopped, match="window"):
-        run_fretting(cfg, tmp_path / "run")
+        run(cfg, tmp_path / "run")
     assert json.loads((tmp_path / "run" / "summary.json").read_text())["stopped"]
 
 
 def test_resume_accepts_a_field_added_since_the_checkpoint_at_its_default_only() -> None:
     """A checkpoint made before a config field existed lacks it: resuming is allowed while
     the field keeps its default (the behaviour the checkpoint ran with), refused otherwise."""
-    from tribodem.fretting.cli import FrettingConfig, check_resume
+    from tribodem.fretting.config import FrettingConfig, check_resume
     from tribodem.io.config import ConfigError
 
     cfg = FrettingConfig()
@@ -318,7 +321,7 @@ def test_a_recorded_config_from_before_config_version_2_reads_the_old_defaults_a
     refuses 0.25 (a/4 is another run), naming the values fe3d gets; old fe and elastic
     checkpoints resume with the fields left out or at 0.25 / 40. A marked config (this
     version's) is read as it is: its fe3d 0.25 stays a/4."""
-    from tribodem.fretting.cli import (
+    from tribodem.fretting.config import (
         CONFIG_VERSION,
         FrettingConfig,
         check_resume,
@@ -360,7 +363,7 @@ def test_a_version_2_record_keeps_the_flow_stress_its_ccx_bodies_ran_with(
     hardening given, elastic bodies or tamaas -> 'line'. Its resume from a config that
     leaves beyond_uts out (now 'line') is refused naming the field; a run's version-2
     config.toml given back with --config runs 'hold' as it did."""
-    from tribodem.fretting.cli import (
+    from tribodem.fretting.config import (
         CONFIG_VERSION,
         FrettingConfig,
         check_resume,
@@ -403,7 +406,7 @@ def test_a_version_3_record_keeps_the_low_friction_its_ccx_bodies_were_loaded_wi
     change it (the cycles after are another run's: each cycle's ``loading_mu`` says which
     ran); a run's version-3 config.toml given back with --config loads the bodies as it
     did."""
-    from tribodem.fretting.cli import (
+    from tribodem.fretting.config import (
         CONFIG_VERSION,
         FrettingConfig,
         check_resume,
@@ -431,7 +434,8 @@ def test_a_version_3_record_keeps_the_low_friction_its_ccx_bodies_were_loaded_wi
         assert resolve_config(given_back).fe.loading_friction == "low"
     elastic = FrettingConfig(solver="elastic")
     other = recorded_config(v3(elastic))  # the field does nothing there: the default
-    assert other["fe"]["loading_friction"] == "auto" and other["config_version"] == 4
+    assert other["fe"]["loading_friction"] == "auto"
+    assert other["config_version"] == CONFIG_VERSION
     assert resolve_config(None, base=other) == elastic
 
 
@@ -439,7 +443,7 @@ def test_a_new_config_round_trips_with_its_marker(tmp_path: Path) -> None:
     """What tribodem writes carries config_version: config.toml (the [fe] fields left out
     stay out and reload as left out) and a checkpoint (read back unchanged, None stays
     None, so a resume makes the same run)."""
-    from tribodem.fretting.cli import (
+    from tribodem.fretting.config import (
         CONFIG_VERSION,
         FrettingConfig,
         check_resume,
@@ -468,34 +472,34 @@ def test_a_checkpoint_from_before_config_version_2_resumes(tmp_path: Path) -> No
     40) resumes: from its own config (``--resume`` alone) and from a config file that leaves
     [fe] out; the resumed run records the marker and the fields left out. Old study.toml
     files and a sweep member's old summary.json are read the same way."""
-    from tribodem.fretting.cli import _jsonable, recorded_config
+    from tribodem.fretting.config import recorded_config
     from tribodem.fretting.output import CHECKPOINT, read_checkpoint, write_checkpoint
     from tribodem.fretting.record import study_diffs
-    from tribodem.fretting.sweep import member_plan
+    from tribodem.fretting.table_sweep import member_plan
     from tribodem.io.config import dump_toml
 
     cfg = resolve_config(None, quick=True, overrides={
         "cycles": 2, "output": {"figures": False, "vtk": False}})
     out = tmp_path / "run"
-    run_fretting(cfg, out)
+    run(cfg, out)
     meta, state = read_checkpoint(out / CHECKPOINT)
     old = _before_v2(cfg)
     write_checkpoint(out / CHECKPOINT, {**meta, "config": old}, state)
     more = resolve_config(None, overrides={"cycles": 3}, base=recorded_config(old))
     assert more == cfg.model_copy(update={"cycles": 3})
-    run_fretting(more, out, resume=True)
+    run(more, out, resume=True)
     meta, state = read_checkpoint(out / CHECKPOINT)
-    assert meta["cycles_done"] == 3 and meta["config"] == _jsonable(more)
+    assert meta["cycles_done"] == 3 and meta["config"] == more.record()
     write_checkpoint(out / CHECKPOINT, {**meta, "config": _before_v2(more)}, state)
-    run_fretting(more.model_copy(update={"cycles": 4}), out, resume=True)  # --config FILE
+    run(more.model_copy(update={"cycles": 4}), out, resume=True)  # --config FILE
     assert read_checkpoint(out / CHECKPOINT)[0]["cycles_done"] == 4
     # a study's study.toml and a sweep member's summary.json of before
     (tmp_path / "study.toml").write_text(dump_toml({"config": old, "quick": True}))
-    assert study_diffs(tmp_path, {"config": _jsonable(cfg), "quick": True}) == []
+    assert study_diffs(tmp_path, {"config": cfg.record(), "quick": True}) == []
     member = tmp_path / "member"
     member.mkdir()
     (member / "summary.json").write_text(json.dumps({"config": old, "cycles": 2}))
-    assert member_plan(_jsonable(cfg), member)[0] == "done"
+    assert member_plan(cfg.record(), member)[0] == "done"
 
 
 def test_a_study_resumes_with_other_threads_or_retries_and_names_what_may_not_change(
@@ -505,21 +509,20 @@ def test_a_study_resumes_with_other_threads_or_retries_and_names_what_may_not_ch
     fe3d study goes on on another machine, or with more retries after a non-convergence);
     a field that makes another run is refused by name with both values, and so is
     ``--quick``."""
-    from tribodem.fretting.cli import _jsonable
     from tribodem.fretting.record import study_diffs
     from tribodem.io.config import dump_toml
 
     cfg = resolve_config(None, overrides={"solver": "fe3d", "fe": {"threads": 2}})
-    (tmp_path / "study.toml").write_text(dump_toml({"config": _jsonable(cfg), "quick": False}))
+    (tmp_path / "study.toml").write_text(dump_toml({"config": cfg.record(), "quick": False}))
     other = cfg.model_copy(update={"fe": cfg.fe.model_copy(
         update={"threads": 1, "retries": 4, "timeout": 7200.0})})
-    assert study_diffs(tmp_path, {"config": _jsonable(other), "quick": False}) == []
+    assert study_diffs(tmp_path, {"config": other.record(), "quick": False}) == []
     rougher = cfg.model_copy(update={"contact": cfg.contact.model_copy(
         update={"friction": 0.7})})
-    assert study_diffs(tmp_path, {"config": _jsonable(rougher), "quick": True}) == [
+    assert study_diffs(tmp_path, {"config": rougher.record(), "quick": True}) == [
         f"contact.friction = 0.7 (study: {cfg.contact.friction!r})", "quick = True (study: False)"]
     # a debris study's cycle is its phases' cycle: there, cycles may not change
-    later = _jsonable(cfg.model_copy(update={"cycles": 40}))
+    later = cfg.model_copy(update={"cycles": 40}).record()
     assert study_diffs(tmp_path, {"config": later, "quick": False}) == []
     assert study_diffs(tmp_path, {"config": later, "quick": False}, may_change=("fe.",)) == [
         f"cycles = 40 (study: {cfg.cycles!r})"]
@@ -530,19 +533,19 @@ def test_a_recorded_config_reloads_to_the_same_config(tmp_path: Path) -> None:
     null) reloads to the same config, field for field: a field left out (None) whose
     default is not None, such as ``[fe] max_wear_slope = "off"`` (default 0.1), is recorded
     in a form that reloads as itself."""
-    from tribodem.fretting.cli import FrettingConfig, _jsonable, recorded_config
+    from tribodem.fretting.config import FrettingConfig, recorded_config
     from tribodem.io.config import dump_toml, load_toml
 
     cfg = resolve_config(None, overrides={"solver": "fe3d", "fe": {
         "max_wear_slope": "off", "h_over_a": 0.25, "timeout": 60.0}})
     assert cfg.fe.max_wear_slope is None and cfg.fe.size_factor is None
     path = tmp_path / "config.toml"
-    path.write_text(dump_toml(_jsonable(cfg)))
+    path.write_text(dump_toml(cfg.record()))
     assert FrettingConfig.model_validate(recorded_config(load_toml(path))) == cfg
     assert resolve_config(None, base=recorded_config(load_toml(path))) == cfg
     # and the run's own config.toml, given back with --config
     out = tmp_path / "run"
-    run_fretting(resolve_config(None, quick=True, overrides={
+    run(resolve_config(None, quick=True, overrides={
         "cycles": 1, "fe": {"max_wear_slope": "off"}, "output": {"figures": False,
                                                                  "vtk": False}}), out)
     assert resolve_config(out / "config.toml").fe.max_wear_slope is None

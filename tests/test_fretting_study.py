@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 from conftest import default_sigint, run_tribodem, tribodem_exe
 
-from tribodem.fretting.study import (
+from tribodem.fretting.chapter6 import (
     SEED,
     Stage,
     compare,
@@ -198,7 +198,7 @@ def test_select_stages() -> None:
     naming the allowed ones."""
     import pytest
 
-    from tribodem.fretting.study import select
+    from tribodem.fretting.chapter6 import select
 
     plan = stages()
     assert [s.name for s in select(plan, ("swt", "s22"))] == ["s22", "swt"]

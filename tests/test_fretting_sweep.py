@@ -51,13 +51,13 @@ figures = false
 vtk = false
 """
 #: b's load changed, new columns empty (the base's values) for a, b, c, and a row d whose
-#: solver cannot be built (a line contact in the Ciavarella-Jaeger regime: the half-space
-#: solver refuses it when it is built, in the member's task)
-CHANGED = """name,contact.geometry,contact.regime,contact.load,wear.criterion,cycles
-a,,,100,energy,2
-b,,,60,archard,3
-c,,,80,energy,2
-d,cylinder_on_flat,ciavarella-jaeger,100,energy,2
+#: solver cannot be built (a line contact in the Ciavarella-Jaeger regime on the periodic
+#: window: the half-space solver refuses it when it is built, in the member's task)
+CHANGED = ("name,contact.geometry,contact.regime,elastic.line_model,contact.load,"
+           "wear.criterion,cycles\n") + """a,,,,100,energy,2
+b,,,,60,archard,3
+c,,,,80,energy,2
+d,cylinder_on_flat,ciavarella-jaeger,periodic-2d,100,energy,2
 """
 ROWS = {"a": (100.0, "energy", 2), "b": (50.0, "archard", 3), "c": (80.0, "energy", 2)}
 

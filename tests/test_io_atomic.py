@@ -47,3 +47,20 @@ def test_interrupt_found_in_the_exception_chain() -> None:
     except SystemError as err:
         assert _interrupt_in_chain(err)
     assert not _interrupt_in_chain(ValueError("plain"))
+
+
+def test_interrupted_message_says_where_the_outputs_are(tmp_path: Path) -> None:
+    """The Ctrl-C message is ``runs``' (the entry only looks it up once loaded)."""
+    import tribodem._entry as entry
+
+    out = tmp_path / "run"
+    out.mkdir()
+    (out / "checkpoint.npz").write_text("x")
+    runs.announce(out, out / "checkpoint.npz", resume_hint="add --resume")
+    try:
+        text = runs.interrupted_message()
+        assert text.startswith("\ninterrupted (Ctrl-C): ") and str(out) in text
+        assert "checkpoint" in text and "--resume" in text
+        assert entry.interrupted_message() == text
+    finally:
+        runs._current.out = None  # nothing announced, as at the start

@@ -8,6 +8,7 @@ exit 2 = bad input (refused before any work), exit 3 = run stopped (instability)
 
 from __future__ import annotations
 
+import errno
 import sys
 
 import typer
@@ -87,17 +88,18 @@ def main() -> None:
 
     0 done; 2 usage or validation error (typer's own short message, or field, value and what
     is allowed); 3 the run stopped early (instability, contact outgrew the window): outputs
-    kept; 130 Ctrl-C, after saying where the outputs and the last checkpoint are. None of
+    kept, also after a fault of the file system (a full disk, a folder made read-only); 130
+Ctrl-C, 143 SIGTERM, after saying where the outputs and the last checkpoint are. None of
     these prints a traceback.
     """
-    from tribodem._entry import interrupted_message
-    from tribodem.io import runs
+    from tribodem.io import runs, signals
 
     def interrupted() -> None:
-        typer.echo(interrupted_message(), err=True)
-        sys.exit(130)
+        typer.echo(runs.interrupted_message(), err=True)
+        sys.exit(signals.exit_code())
 
     try:
+        _refuse_empty_values(sys.argv[1:])
         _register(sys.argv[1:])
         # without standalone mode typer *returns* the code of an Exit it caught, and turns
         # Ctrl-C into Exit(130): map both here
@@ -126,12 +128,45 @@ def main() -> None:
         else:
             typer.echo(f"error: {err}", err=True)
         sys.exit(getattr(err, "exit_code", 2) or 2)
+    except OSError as err:
+        if err.errno not in FILE_SYSTEM_FAULTS:
+            raise
+        # a fault of the file system: before any work nothing was touched (exit 2); during
+        # a run the last complete outputs and checkpoint are kept (exit 3)
+        what = f"{err.strerror or err}" + (f": '{err.filename}'" if err.filename else "")
+        if not runs.started():
+            typer.echo(f"error: cannot write the outputs: {what}", err=True)
+            sys.exit(2)
+        typer.echo(f"run stopped: a file could not be written: {what}", err=True)
+        where = runs.where()
+        if where:
+            typer.echo(where, err=True)
+        sys.exit(3)
     except Exception as err:
         # Ctrl-C inside compiled or C code (numba loading a kernel, for one) can surface as
         # another exception whose cause is the KeyboardInterrupt: still a Ctrl-C
         if _interrupt_in_chain(err):
             interrupted()
         raise
+
+
+def _refuse_empty_values(argv: list[str]) -> None:
+    """Refuse an option given the empty string (``--out ''`` would silently mean the
+    current folder once typer has made it a path): ``ConfigError`` naming the option."""
+    for i, arg in enumerate(argv):
+        if not arg.startswith("--"):
+            continue
+        name, eq, value = arg.partition("=")
+        if eq and not value.strip():
+            raise ConfigError(f"{name} = '': allowed: a value (not empty)")
+        if not eq and i + 1 < len(argv) and not argv[i + 1].strip():
+            raise ConfigError(f"{name} = '': allowed: a value (not empty)")
+
+
+#: errors of the file system that end a run cleanly (the disk, permissions, names, the mount)
+FILE_SYSTEM_FAULTS = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EACCES, errno.EPERM,
+                                errno.ENAMETOOLONG, errno.EROFS, errno.EIO, errno.ENOTDIR,
+                                errno.EISDIR, errno.EEXIST, errno.ENOENT})
 
 
 def _interrupt_in_chain(err: BaseException) -> bool:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import csv
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -107,7 +108,7 @@ def trend_verdict(steps: list[tuple[float, float]], total: tuple[float, float],
 
 def steady_rate(r: dict[str, Any]) -> float:
     """A run's steady wear rate per sliding distance (m/m): ``wear_rate_steady_m_per_m``
-    (after the run-in, issue 15), or for runs made before it the second-half rate in time
+    (after the run-in), or for runs made before that field the second-half rate in time
     divided by the speed."""
     if "wear_rate_steady_m_per_m" in r:
         return float(r["wear_rate_steady_m_per_m"])
@@ -134,7 +135,7 @@ def ci95(se: float, n: int) -> float:
 
 
 #: the half-width (percentage points) a sweep's paired 95% intervals are sized for in the
-#: "packings needed" estimate (issue 15's target)
+#: "packings needed" estimate
 TARGET_CI95_PP = 10.0
 
 
@@ -174,7 +175,7 @@ def _num(x: float) -> float | None:
     return float(x) if x is not None and np.isfinite(x) else None
 
 
-def _length_text(results: dict[int, dict[str, Any]], t_sim: float) -> str:
+def length_text(results: dict[int, dict[str, Any]], t_sim: float) -> str:
     """What the runs simulate: the same time for every condition (the seed's way), or
     the same sliding distance (``[run] distance_m``: the times differ with the speed)."""
     times = [float(r["simulated_time_s"]) for r in results.values()]
@@ -189,23 +190,41 @@ def _length_text(results: dict[int, dict[str, Any]], t_sim: float) -> str:
             " of sliding); the seed's 8 s are not simulated.")
 
 
-def write_comparison(out: Path, runs: dict[int, list[tuple[dict[str, Any], Path]]],
-                     wall_s: float, cluster: str | int, quick: bool,
-                     failed: dict[str, str] | None = None) -> list[tuple[str, str, str]]:
-    """Write comparison.csv and comparison.md from the runs of each condition (one per
-    packing seed): seed means, the standard error of each change over seeds, and a
-    verdict per change and per trend; return (label, ours, seed) wear rows.
+@dataclass
+class SweepStats:
+    """What a comparison is made of: the runs of each condition (summary, folder; one per
+    packing), the conditions without any run (``missing``), the mean summary per
+    condition, the packings compared (the fewest of any condition), each condition's
+    first time series, the per-packing values of each quantity (``wear`` m, ``rate``
+    m/m, ``contact``, ``chains``, ``strong``: late means) with their means and standard
+    deviations, and the paired changes (%, standard error %) of every seed change."""
 
-    ``failed`` (member -> error) is listed; a condition without any run (all its members
-    failed) leaves the changes and trends that need it unevaluated ("-")."""
-    runs = {k: v for k, v in runs.items() if v}
-    if not runs:
-        raise ValueError("write_comparison: no runs")
-    nan = (float("nan"), float("nan"))
-    missing = [k for k in CONDITIONS if k not in runs]
-    results = {k: _mean_summary([r for r, _ in v]) for k, v in runs.items()}
-    n_seeds = min(len(v) for v in runs.values())
-    series = {k: _series(v[0][1]) for k, v in runs.items()}  # condition 5 history: seed 0
+    runs: dict[int, list[tuple[dict[str, Any], Path]]]
+    missing: list[int]
+    results: dict[int, dict[str, Any]]
+    n_seeds: int
+    series: dict[int, dict[str, np.ndarray]]
+    per_seed: dict[str, dict[int, np.ndarray]]
+    wear: dict[int, float]
+    spread: dict[int, float]
+    rate: dict[int, float]
+    rate_sd: dict[int, float]
+    contact: dict[int, float]
+    chains: dict[int, float]
+    strong: dict[int, float]
+    ch: dict[str, dict[tuple[int, int], tuple[float, float]]]
+
+    @property
+    def t_sim(self) -> float:
+        """The simulated time (s) of the first condition's mean summary."""
+        return float(next(iter(self.results.values()))["simulated_time_s"])
+
+
+def _per_packing(runs: dict[int, list[tuple[dict[str, Any], Path]]], missing: list[int]
+                 ) -> dict[str, dict[int, np.ndarray]]:
+    """Per quantity and condition, the values of its packings: the end wear depth (m),
+    the steady wear rate (m/m), the contact fraction and the late means of the force
+    chains and the strong ones; a missing condition has one nan."""
     per_seed = {
         "wear": {k: np.array([r["wear_depth_mean_m"] for r, _ in v]) for k, v in runs.items()},
         "rate": {k: np.array([steady_rate(r) for r, _ in v]) for k, v in runs.items()},
@@ -218,121 +237,191 @@ def write_comparison(out: Path, runs: dict[int, list[tuple[dict[str, Any], Path]
     }
     for q in per_seed:
         per_seed[q].update({k: np.full(1, np.nan) for k in missing})
-    wear = {k: float(x.mean()) for k, x in per_seed["wear"].items()}
-    spread = {k: float(x.std(ddof=1)) if x.size > 1 else float("nan")
-              for k, x in per_seed["wear"].items()}
-    rate = {k: float(x.mean()) for k, x in per_seed["rate"].items()}
-    rate_sd = {k: float(x.std(ddof=1)) if x.size > 1 else float("nan")
-               for k, x in per_seed["rate"].items()}
-    contact = {k: float(x.mean()) for k, x in per_seed["contact"].items()}
-    chains = {k: float(x.mean()) for k, x in per_seed["chains"].items()}
-    strong = {k: float(x.mean()) for k, x in per_seed["strong"].items()}
+    return per_seed
+
+
+def _means(x: dict[int, np.ndarray]) -> dict[int, float]:
+    return {k: float(v.mean()) for k, v in x.items()}
+
+
+def _sds(x: dict[int, np.ndarray]) -> dict[int, float]:
+    return {k: float(v.std(ddof=1)) if v.size > 1 else float("nan") for k, v in x.items()}
+
+
+def sweep_stats(runs: dict[int, list[tuple[dict[str, Any], Path]]]) -> SweepStats:
+    """The :class:`SweepStats` of the runs of each condition (``ValueError`` without any)."""
+    runs = {k: v for k, v in runs.items() if v}
+    if not runs:
+        raise ValueError("write_comparison: no runs")
+    nan = (float("nan"), float("nan"))
+    missing = [k for k in CONDITIONS if k not in runs]
+    results = {k: _mean_summary([r for r, _ in v]) for k, v in runs.items()}
+    n_seeds = min(len(v) for v in runs.values())
+    series = {k: _series(v[0][1]) for k, v in runs.items()}  # condition 5 history: seed 0
+    per_seed = _per_packing(runs, missing)
     ch: dict[str, dict[tuple[int, int], tuple[float, float]]] = {
         q: {(a, b): change_with_error(per_seed[q][a], per_seed[q][b])
             if a in runs and b in runs else nan
             for _, a, b, _, _ in SEED_CHANGES} for q in per_seed if q != "contact"}
-    rows_csv = []
-    lines = []
-    printed = []
-    need: list[str] = []
-    trends_json = []
+    return SweepStats(
+        runs=runs, missing=missing, results=results, n_seeds=n_seeds, series=series,
+        per_seed=per_seed, wear=_means(per_seed["wear"]), spread=_sds(per_seed["wear"]),
+        rate=_means(per_seed["rate"]), rate_sd=_sds(per_seed["rate"]),
+        contact=_means(per_seed["contact"]), chains=_means(per_seed["chains"]),
+        strong=_means(per_seed["strong"]), ch=ch)
+
+
+@dataclass
+class ChangeTable:
+    """The seed's changes evaluated: comparison.csv's rows, the markdown table's lines,
+    the (label, ours, seed) wear rows printed, the packings needed per change and
+    comparison.json's trends."""
+
+    rows_csv: list[list[Any]] = field(default_factory=list)
+    lines: list[str] = field(default_factory=list)
+    printed: list[tuple[str, str, str]] = field(default_factory=list)
+    need: list[str] = field(default_factory=list)
+    trends_json: list[dict[str, Any]] = field(default_factory=list)
+
+
+def _yes(x: bool | None) -> str:
+    return "-" if x is None else ("yes" if x else "no")
+
+
+def _add_change(t: ChangeTable, st: SweepStats, label: str, a: int, b: int, seed_w: float,
+                seed_c: float | None) -> None:
+    """Evaluate one seed change (conditions ``a`` -> ``b``, the seed's wear and chain
+    changes %) into ``t``."""
+    n_seeds, wear, rate, chains = st.n_seeds, st.wear, st.rate, st.chains
+    (ow, ow_se), (orr, orr_se) = st.ch["wear"][(a, b)], st.ch["rate"][(a, b)]
+    (oc, oc_se), (os_, _) = st.ch["chains"][(a, b)], st.ch["strong"][(a, b)]
+    hw, hr, hc = (ci95(x, n_seeds) for x in (ow_se, orr_se, oc_se))
+    t.rows_csv.append([label, a, b, n_seeds, wear[a], wear[b], ow, ow_se,
+                       step_verdict(ow, ow_se, n_seeds), seed_w, rate[a], rate[b], orr, orr_se,
+                       step_verdict(orr, orr_se, n_seeds), chains[a], chains[b], oc, oc_se,
+                       "" if seed_c is None else seed_c, os_, hw, hr, hc])
+    inside_w, inside_c = seed_inside(seed_w, ow, hw), seed_inside(seed_c, oc, hc)
+    t.lines.append(f"| {label} | {a}->{b} | {wear[a] * 1e6:.2f} -> {wear[b] * 1e6:.2f} | "
+                   f"{_ci(ow, hw)} | {_fmt(seed_w)} | {_yes(inside_w)} | "
+                   f"{step_verdict(ow, ow_se, n_seeds)} | "
+                   f"{_ci(orr, hr)} | {step_verdict(orr, orr_se, n_seeds)} | "
+                   f"{chains[a]:.0f} -> {chains[b]:.0f} | {_ci(oc, hc)} | "
+                   f"{_fmt(seed_c)} | {_yes(inside_c)} |")
+    t.printed.append((label, _ci(ow, hw), _fmt(seed_w)))
+    need_w = packings_for(ow_se, n_seeds)
+    t.need.append(f"{label} {need_w or '-'}")
+    for q, seed_pct, pct, half, inside, se, need_q in (
+            ("wear_depth", seed_w, ow, hw, inside_w, ow_se, need_w),
+            ("force_chains", seed_c, oc, hc, inside_c, oc_se, packings_for(oc_se, n_seeds))):
+        if seed_pct is None:
+            continue
+        t.trends_json.append({
+            "change": label, "from_condition": a, "to_condition": b, "quantity": q,
+            "seed_pct": seed_pct, "ours_pct": _num(pct), "ci95_pct": _num(half),
+            "se_pct": _num(se), "reproduced": inside,
+            "packings_for_ci95_10pp": need_q,
+            "resolved": None if not np.isfinite(half) else bool(abs(pct) > half)})
+
+
+def change_table(st: SweepStats) -> ChangeTable:
+    """Every seed change of section 5 (``SEED_CHANGES``) evaluated on the sweep."""
+    t = ChangeTable()
     for label, a, b, seed_w, seed_c in SEED_CHANGES:
-        (ow, ow_se), (orr, orr_se) = ch["wear"][(a, b)], ch["rate"][(a, b)]
-        (oc, oc_se), (os_, _) = ch["chains"][(a, b)], ch["strong"][(a, b)]
-        hw, hr, hc = (ci95(x, n_seeds) for x in (ow_se, orr_se, oc_se))
-        rows_csv.append([label, a, b, n_seeds, wear[a], wear[b], ow, ow_se,
-                         step_verdict(ow, ow_se, n_seeds), seed_w, rate[a], rate[b], orr, orr_se,
-                         step_verdict(orr, orr_se, n_seeds), chains[a], chains[b], oc, oc_se,
-                         "" if seed_c is None else seed_c, os_, hw, hr, hc])
-        inside_w, inside_c = seed_inside(seed_w, ow, hw), seed_inside(seed_c, oc, hc)
+        _add_change(t, st, label, a, b, seed_w, seed_c)
+    return t
 
-        def yes(x: bool | None) -> str:
-            return "-" if x is None else ("yes" if x else "no")
 
-        lines.append(f"| {label} | {a}->{b} | {wear[a] * 1e6:.2f} -> {wear[b] * 1e6:.2f} | "
-                     f"{_ci(ow, hw)} | {_fmt(seed_w)} | {yes(inside_w)} | "
-                     f"{step_verdict(ow, ow_se, n_seeds)} | "
-                     f"{_ci(orr, hr)} | {step_verdict(orr, orr_se, n_seeds)} | "
-                     f"{chains[a]:.0f} -> {chains[b]:.0f} | {_ci(oc, hc)} | "
-                     f"{_fmt(seed_c)} | {yes(inside_c)} |")
-        printed.append((label, _ci(ow, hw), _fmt(seed_w)))
-        need_w = packings_for(ow_se, n_seeds)
-        need.append(f"{label} {need_w or '-'}")
-        for q, seed_pct, pct, half, inside, se, need_q in (
-                ("wear_depth", seed_w, ow, hw, inside_w, ow_se, need_w),
-                ("force_chains", seed_c, oc, hc, inside_c, oc_se, packings_for(oc_se, n_seeds))):
-            if seed_pct is None:
-                continue
-            trends_json.append({
-                "change": label, "from_condition": a, "to_condition": b, "quantity": q,
-                "seed_pct": seed_pct, "ours_pct": _num(pct), "ci95_pct": _num(half),
-                "se_pct": _num(se), "reproduced": inside,
-                "packings_for_ci95_10pp": need_q,
-                "resolved": None if not np.isfinite(half) else bool(abs(pct) > half)})
-    write_csv(out / "comparison.csv",
-              ["change", "from_condition", "to_condition", "seeds", "wear_depth_from_m",
-               "wear_depth_to_m", "wear_depth_change_pct", "wear_depth_change_se_pct",
-               "wear_depth_verdict", "seed_wear_depth_change_pct", "wear_rate_from_m_per_m",
-               "wear_rate_to_m_per_m", "wear_rate_change_pct", "wear_rate_change_se_pct",
-               "wear_rate_verdict", "force_chains_from", "force_chains_to",
-               "force_chains_change_pct", "force_chains_change_se_pct",
-               "seed_force_chains_change_pct", "strong_force_chains_change_pct",
-               "wear_depth_change_ci95_pct", "wear_rate_change_ci95_pct",
-               "force_chains_change_ci95_pct"], rows_csv)
+#: comparison.csv's columns
+CSV_COLUMNS = [
+    "change", "from_condition", "to_condition", "seeds", "wear_depth_from_m",
+    "wear_depth_to_m", "wear_depth_change_pct", "wear_depth_change_se_pct",
+    "wear_depth_verdict", "seed_wear_depth_change_pct", "wear_rate_from_m_per_m",
+    "wear_rate_to_m_per_m", "wear_rate_change_pct", "wear_rate_change_se_pct",
+    "wear_rate_verdict", "force_chains_from", "force_chains_to",
+    "force_chains_change_pct", "force_chains_change_se_pct",
+    "seed_force_chains_change_pct", "strong_force_chains_change_pct",
+    "wear_depth_change_ci95_pct", "wear_rate_change_ci95_pct",
+    "force_chains_change_ci95_pct"]
 
-    def trend(q: str, ks: tuple[int, int, int], want: str) -> str:
-        a, b, c = ks
-        lost = [k for k in ks if k in missing]
-        if lost:
-            return f"not evaluated: no run of condition {', '.join(map(str, lost))}"
-        return trend_verdict([ch[q][(a, b)], ch[q][(b, c)]], ch[q][(a, c)], want, n_seeds)
 
-    verdicts = [
+def _trend(st: SweepStats, q: str, ks: tuple[int, int, int], want: str) -> str:
+    """The verdict on the trend of quantity ``q`` over conditions ``ks`` (``want``: up or
+    down); not evaluated when a condition has no run."""
+    a, b, c = ks
+    lost = [k for k in ks if k in st.missing]
+    if lost:
+        return f"not evaluated: no run of condition {', '.join(map(str, lost))}"
+    return trend_verdict([st.ch[q][(a, b)], st.ch[q][(b, c)]], st.ch[q][(a, c)], want,
+                         st.n_seeds)
+
+
+def verdicts(st: SweepStats) -> list[tuple[str, str]]:
+    """(trend, verdict) of the seed's six trends: wear depth and steady rate up with load
+    and speed, force chains down with both."""
+    return [
         ("wear depth rises with load (13 -> 17 -> 21 kN; seed +24.75%)",
-         trend("wear", (1, 2, 5), "up")),
+         _trend(st, "wear", (1, 2, 5), "up")),
         ("wear depth rises with speed (800 -> 1000 -> 1200 r/min; seed +16.22%)",
-         trend("wear", (3, 4, 5), "up")),
-        ("steady wear rate per distance rises with load", trend("rate", (1, 2, 5), "up")),
-        ("steady wear rate per distance rises with speed", trend("rate", (3, 4, 5), "up")),
+         _trend(st, "wear", (3, 4, 5), "up")),
+        ("steady wear rate per distance rises with load", _trend(st, "rate", (1, 2, 5), "up")),
+        ("steady wear rate per distance rises with speed",
+         _trend(st, "rate", (3, 4, 5), "up")),
         ("force chains fall with load (seed -23.37%, -5.96%)",
-         trend("chains", (1, 2, 5), "down")),
+         _trend(st, "chains", (1, 2, 5), "down")),
         ("force chains fall with speed (seed -15.58%, -3.86%)",
-         trend("chains", (3, 4, 5), "down")),
+         _trend(st, "chains", (3, 4, 5), "down")),
     ]
-    r5 = results.get(5)
-    s5 = series.get(5)
-    t_sim = float(next(iter(results.values()))["simulated_time_s"])
+
+
+def _history_lines(st: SweepStats) -> list[str]:
+    """The condition 5 history (packing 0) beside figure 12: the seed's times mapped to
+    the same fractions of the simulated window."""
+    r5, s5 = st.results.get(5), st.series.get(5)
     hist = []
-    t5 = float(r5["simulated_time_s"]) if r5 is not None else t_sim  # distance_m: its own
+    t5 = float(r5["simulated_time_s"]) if r5 is not None else st.t_sim  # distance_m: its own
     for ts, hs in SEED_FIG12 if s5 is not None else []:
         tt = ts / SEED_BRAKING_TIME_S * t5
         h = float(np.interp(tt, s5["time_s"], s5["wear_depth_mean_m"]))
         hist.append(f"| {ts:g} | {hs * 1e3:.3g} | {tt * 1e6:.3g} | {h * 1e3:.3g} | "
                     f"{hs / SEED_FIG12[-1][1]:.3f} | "
                     f"{h / max(float(s5['wear_depth_mean_m'][-1]), 1e-300):.3f} |")
+    return hist
+
+
+def _condition_lines(st: SweepStats) -> list[str]:
+    """One markdown row per condition: table 4, the simulated window, the means +- sd."""
     per = []
-    for k in sorted(results):
-        r = results[k]
+    for k in sorted(st.results):
+        r = st.results[k]
         c = CONDITIONS[k]
         per.append(f"| {k} | {c.load_kN:g} | {r['pressure_Pa'] / 1e6:.4g} | {c.rpm:g} | "
                    f"{r['sliding_speed_m_s']:.4g} | {r['simulated_time_s'] * 1e6:.3g} | "
                    f"{r['simulated_sliding_distance_m'] * 1e6:.4g} | "
-                   f"{wear[k] * 1e6:.2f} +- {_sd(spread[k] * 1e6, '.2f')} | "
-                   f"{rate[k] * 1e3:.3g} +- {_sd(rate_sd[k] * 1e3, '.2g')} | "
-                   f"{contact[k]:.3f} | "
+                   f"{st.wear[k] * 1e6:.2f} +- {_sd(st.spread[k] * 1e6, '.2f')} | "
+                   f"{st.rate[k] * 1e3:.3g} +- {_sd(st.rate_sd[k] * 1e3, '.2g')} | "
+                   f"{st.contact[k]:.3f} | "
                    f"{r['wear_depth_max_m'] * 1e6:.1f} | "
                    f"{r['wear_depth_mean_disc_m'] * 1e6:.2f} | {r['broken_bonds']:.0f} "
                    f"({r['broken_bonds_tensile']:.0f}/{r['broken_bonds_shear']:.0f}) | "
-                   f"{r['debris_particles']:.0f} | {chains[k]:.0f} | {strong[k]:.0f} | "
+                   f"{r['debris_particles']:.0f} | {st.chains[k]:.0f} | {st.strong[k]:.0f} | "
                    f"{r['mean_wall_pressure_ratio']:.3f} | "
                    f"{r['particles_final']:.0f}/{r['particles_initial']:.0f} | "
                    f"{r['wall_time_s']:.0f} |")
-    seeds_txt = "; ".join(
-        f"{k}: " + ", ".join(f"{x * 1e6:.1f}" for x in per_seed["wear"][k])
-        for k in sorted(per_seed["wear"]))
-    rel = [spread[k] / wear[k] for k in wear if wear[k] > 0 and np.isfinite(spread[k])]
-    rel_rate = {k: rate_sd[k] / rate[k] for k in rate
-                if rate[k] > 0 and np.isfinite(rate_sd[k])}
+    return per
+
+
+def _rel_rate(st: SweepStats) -> dict[int, float]:
+    """Per condition the scatter (sd / mean) of the steady wear rate between packings."""
+    return {k: st.rate_sd[k] / st.rate[k] for k in st.rate
+            if st.rate[k] > 0 and np.isfinite(st.rate_sd[k])}
+
+
+def _scatter_text(st: SweepStats) -> str:
+    """The paragraph on the scatter between packings and the rule of the verdicts."""
+    n_seeds = st.n_seeds
+    rel = [st.spread[k] / st.wear[k] for k in st.wear
+           if st.wear[k] > 0 and np.isfinite(st.spread[k])]
+    rel_rate = _rel_rate(st)
     scatter = (f"Seed-to-seed scatter of the pad wear depth: sd/mean = "
                f"{100 * min(rel):.1f}-{100 * max(rel):.1f}% over {n_seeds} seeds. A change "
                f"is called up/down only when it exceeds {_factor(n_seeds):.2f} standard "
@@ -345,23 +434,35 @@ def write_comparison(out: Path, runs: dict[int, list[tuple[dict[str, Any], Path]
     if rel_rate:
         scatter += (" Scatter of the steady wear rate between packings (sd/mean): " + ", ".join(
             f"condition {k} {100 * v:.0f}%" for k, v in sorted(rel_rate.items())) + ".")
-    extrap = (
+    return scatter
+
+
+def _extrapolation_text(r5: dict[str, Any] | None) -> str:
+    """Condition 5's extrapolation to 8 s beside the seed's depth."""
+    return (
         f"Our linear extrapolation to 8 s (steady rate over the second half, clipped at "
         f"0): {r5['wear_depth_mean_extrapolated_8s_m'] * 1e3:.3g} mm "
         f"(rate {r5['steady_wear_rate_m_s']:.3g} m/s) vs the seed's 7.69e-2 mm: an "
         "extrapolation over ~6 orders of magnitude in time, not a result."
         if r5 is not None else "Condition 5 has no run (not run or failed): no history.")
-    fail_lines = ["## Failed members", "", "Left out of every mean and change above:", "",
-                  *[f"- {m}: {e}" for m, e in failed.items()], ""] if failed else []
-    text = "\n".join([
+
+
+def _md_conditions(st: SweepStats, wall_s: float, cluster: str | int, quick: bool
+                   ) -> list[str]:
+    """comparison.md's title, what was run and the per-condition table."""
+    seeds_txt = "; ".join(
+        f"{k}: " + ", ".join(f"{x * 1e6:.1f}" for x in st.per_seed["wear"][k])
+        for k in sorted(st.per_seed["wear"]))
+    missing = st.missing
+    return [
         "# Braking sweep: tribodem vs seed 000" + (" (--quick)" if quick else ""),
         "",
-        f"Condition(s) {', '.join(map(str, sorted(runs)))} of table 4"
+        f"Condition(s) {', '.join(map(str, sorted(st.runs)))} of table 4"
         + (f" (not run or all failed: {', '.join(map(str, missing))})" if missing else "")
-        + f" x {n_seeds} packing/roughness seed(s) in {wall_s:.0f} s on "
+        + f" x {st.n_seeds} packing/roughness seed(s) in {wall_s:.0f} s on "
         f"{cluster if isinstance(cluster, str) else f'{cluster} worker processes'}; values "
         "are means over packings +- the standard deviation over "
-        f"seeds. {_length_text(results, t_sim)} Wear depth = mean pad "
+        f"seeds. {length_text(st.results, st.t_sim)} Wear depth = mean pad "
         "wear depth at the end (worn solid area / (packing fraction x width)); steady wear "
         "rate = wear depth per sliding distance after the run-in (summary.json "
         "`wear_rate_steady_m_per_m`: slope over the last two thirds of the distance); "
@@ -376,10 +477,17 @@ def write_comparison(out: Path, runs: dict[int, list[tuple[dict[str, Any], Path]
         "broken bonds (tens./shear) | debris | chains | strong chains | mean plate force / "
         "target | particles end/start | wall s |",
         "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
-        *per,
+        *_condition_lines(st),
         "",
         f"Pad wear depth per seed (um), condition: values -- {seeds_txt}.",
         "",
+    ]
+
+
+def _md_changes(st: SweepStats, t: ChangeTable) -> list[str]:
+    """comparison.md's table of changes beside the seed's and the packings needed."""
+    n_seeds = st.n_seeds
+    return [
         "## Changes: ours (mean change +- paired 95% interval) beside the seed's (section 5)",
         "",
         f"Our change = change of the means over {n_seeds} packing(s) +- the half-width of "
@@ -394,18 +502,27 @@ def write_comparison(out: Path, runs: dict[int, list[tuple[dict[str, Any], Path]
         "| seed inside | verdict | our wear-rate change (95%) | verdict | our force chains | "
         "our chain change (95%) | seed chain change | seed inside |",
         "|---|---|---|---|---|---|---|---|---|---|---|---|---|",
-        *lines,
+        *t.lines,
         "",
         f"Packings per condition for a +-{TARGET_CI95_PP:g} pp wear-depth interval at the "
         "scatter measured here (the sd of the per-packing change assumed to stay; "
-        "comparison.json `packings_for_ci95_10pp`): " + "; ".join(need) + "."
+        "comparison.json `packings_for_ci95_10pp`): " + "; ".join(t.need) + "."
         if n_seeds > 1 else "",
         "",
+    ]
+
+
+def _md_trends(st: SweepStats, trends: list[tuple[str, str]],
+               failed: dict[str, str] | None) -> list[str]:
+    """comparison.md's trends, scatter, condition 5 history and failed members."""
+    fail_lines = ["## Failed members", "", "Left out of every mean and change above:", "",
+                  *[f"- {m}: {e}" for m, e in failed.items()], ""] if failed else []
+    return [
         "## Trends",
         "",
-        *[f"- {w}: **{v}**." for w, v in verdicts],
+        *[f"- {w}: **{v}**." for w, v in trends],
         "",
-        scatter,
+        _scatter_text(st),
         "",
         "## Condition 5 history beside figure 12",
         "",
@@ -417,31 +534,59 @@ def write_comparison(out: Path, runs: dict[int, list[tuple[dict[str, Any], Path]
         "| seed t s | seed depth mm | our t us | our depth mm | seed h/h(8 s) | "
         "our h/h(end) |",
         "|---|---|---|---|---|---|",
-        *hist,
+        *_history_lines(st),
         "",
-        extrap,
+        _extrapolation_text(st.results.get(5)),
         "",
         *fail_lines,
-    ])
-    write_text(out / "comparison.md", text)
-    write_json(out / "comparison.json", {
-        "packings": n_seeds,
-        "conditions": {str(k): len(v) for k, v in sorted(runs.items())},
+    ]
+
+
+def _comparison_json(st: SweepStats, t: ChangeTable, trends: list[tuple[str, str]],
+                     failed: dict[str, str] | None, wall_s: float, cluster: str | int
+                     ) -> dict[str, Any]:
+    """comparison.json: the rule, the trends against the seed's, the per-condition means,
+    the verdicts, the failed members, the wall time (s) and the cluster."""
+    rel_rate = _rel_rate(st)
+    return {
+        "packings": st.n_seeds,
+        "conditions": {str(k): len(v) for k, v in sorted(st.runs.items())},
         "rule": "ours_pct = relative change of the means over packings; ci95_pct = half-width "
                 "(percentage points) of the two-sided 95% Student-t interval of the paired "
                 "per-packing changes (t(0.975, n-1) x se); reproduced = |seed_pct - ours_pct| "
                 "<= ci95_pct (null with one packing); resolved = |ours_pct| > ci95_pct",
-        "trends": trends_json,
+        "trends": t.trends_json,
         "per_condition": {str(k): {
-            "packings": int(per_seed["wear"][k].size),
-            "wear_depth_mean_m": _num(wear[k]), "wear_depth_sd_m": _num(spread[k]),
-            "wear_rate_steady_m_per_m": _num(rate[k]),
-            "wear_rate_steady_sd_m_per_m": _num(rate_sd[k]),
+            "packings": int(st.per_seed["wear"][k].size),
+            "wear_depth_mean_m": _num(st.wear[k]), "wear_depth_sd_m": _num(st.spread[k]),
+            "wear_rate_steady_m_per_m": _num(st.rate[k]),
+            "wear_rate_steady_sd_m_per_m": _num(st.rate_sd[k]),
             "wear_rate_steady_scatter": _num(rel_rate.get(k, float("nan"))),
-            "contact_fraction": _num(contact[k])} for k in sorted(results)},
-        "verdicts": {w: v for w, v in verdicts},
+            "contact_fraction": _num(st.contact[k])} for k in sorted(st.results)},
+        "verdicts": {w: v for w, v in trends},
         "failed": dict(failed or {}),
         "wall_time_s": wall_s,
         "cluster": str(cluster),
-    })
-    return printed
+    }
+
+
+def write_comparison(out: Path, runs: dict[int, list[tuple[dict[str, Any], Path]]],
+                     wall_s: float, cluster: str | int, quick: bool,
+                     failed: dict[str, str] | None = None) -> list[tuple[str, str, str]]:
+    """Write comparison.csv, comparison.md and comparison.json from the runs of each
+    condition (one per packing seed): seed means, the standard error of each change over
+    seeds, and a verdict per change and per trend; return (label, ours, seed) wear rows.
+    ``wall_s``: the sweep's wall time (s); ``cluster``: where it ran.
+
+    ``failed`` (member -> error) is listed; a condition without any run (all its members
+    failed) leaves the changes and trends that need it unevaluated ("-")."""
+    st = sweep_stats(runs)
+    t = change_table(st)
+    write_csv(out / "comparison.csv", CSV_COLUMNS, t.rows_csv)
+    trends = verdicts(st)
+    text = "\n".join([*_md_conditions(st, wall_s, cluster, quick), *_md_changes(st, t),
+                      *_md_trends(st, trends, failed)])
+    write_text(out / "comparison.md", text)
+    write_json(out / "comparison.json", _comparison_json(st, t, trends, failed, wall_s,
+                                                         cluster))
+    return t.printed

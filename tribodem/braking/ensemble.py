@@ -1,10 +1,12 @@
 """Braking sweep members on Dask: every (condition, packing) member is one independent task.
 
-``tribodem braking sweep --packings N`` runs its 5 x N members with the ensemble machinery of
-:mod:`tribodem.io.ensemble` (a local cluster of one-thread worker processes, or
-``--scheduler tcp://HOST:PORT``; members done / running / failed; a failed member reported,
-not fatal; Ctrl-C stops the members and closes the cluster). This module says what a
-braking member is (:class:`Member`) and what its task does.
+A sweep (:func:`tribodem.braking.sweep`, ``tribodem braking sweep --packings N``) runs its
+members with the ensemble machinery of :mod:`tribodem.io.ensemble` (a local cluster of
+one-thread worker processes, or ``--scheduler tcp://HOST:PORT``; members done / running /
+failed; a failed member reported, not fatal; Ctrl-C stops the members and closes the
+cluster). This module says what a braking member is (:func:`sweep_members`: an
+:class:`tribodem.io.ensemble.Member` whose task is :func:`run_member`) and what its task
+does.
 
 **A member is idempotent and retry-safe** (:func:`run_member`): the task itself looks at its
 folder when it starts, on whichever worker (:func:`member_plan`), and returns the finished
@@ -19,58 +21,27 @@ alive) write the same bytes.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from tribodem.io.config import ConfigError
-from tribodem.io.ensemble import stop_check
-
-
-@dataclass
-class Member:
-    """One (condition, packing) run of a sweep and its folder (a
-    :class:`tribodem.io.ensemble.Member`: its task is :func:`run_member`)."""
-
-    condition: int
-    packing: int
-    data: dict[str, Any]
-    folder: Path
-
-    @property
-    def key(self) -> tuple[int, int]:
-        return self.condition, self.packing
-
-    @property
-    def label(self) -> str:
-        return f"condition {self.condition} packing {self.packing}"
-
-    @property
-    def task_name(self) -> str:
-        return f"braking-c{self.condition}-p{self.packing}"
-
-    @property
-    def task(self) -> Any:
-        return run_member
-
-    @property
-    def args(self) -> tuple[Any, ...]:
-        return self.data, str(self.folder.resolve())
+from tribodem.braking.checkpoint import CHECKPOINT, finished_summary, read_checkpoint
+from tribodem.braking.config import (
+    BrakingConfig,
+    checkpoint_config,
+    config_differences,
+    setup_from_config,
+)
+from tribodem.braking.simulate import run_in_folder
+from tribodem.io import runs
+from tribodem.io.config import ConfigError, load_toml, merge, validate
+from tribodem.io.ensemble import Member, stop_check
 
 
 def member_plan(cfg_data: dict[str, Any], d: Path) -> tuple[str, Any]:
     """What a sweep member needs: ("done", summary) when ``d`` holds its finished run with
     the same config, ("resume", None) when it holds a usable checkpoint of it, else
     ("new", why-not-reused or None)."""
-    from tribodem.braking.cli import (
-        BrakingConfig,
-        _checkpoint_config,
-        _finished_summary,
-        config_differences,
-    )
-    from tribodem.braking.run import CHECKPOINT, read_checkpoint
-    from tribodem.io.config import load_toml, validate
-
     new = validate(BrakingConfig, cfg_data, source="sweep").model_dump()
     own = d / "config.toml"
     if not own.is_file():
@@ -82,7 +53,7 @@ def member_plan(cfg_data: dict[str, Any], d: Path) -> tuple[str, Any]:
     diff = config_differences(old, new)
     if diff:
         return "new", f"{diff[0][0]} changed from {diff[0][1]!r} to {diff[0][2]!r}"
-    done = _finished_summary(d)
+    done = finished_summary(d)
     if done is not None:
         return "done", done
     ck = d / CHECKPOINT
@@ -90,7 +61,7 @@ def member_plan(cfg_data: dict[str, Any], d: Path) -> tuple[str, Any]:
         return "new", None
     try:
         rec = read_checkpoint(ck)
-        ck_cfg = _checkpoint_config(rec, ck)
+        ck_cfg = checkpoint_config(rec, ck)
     except ConfigError as err:
         return "new", str(err)
     if ck_cfg is not None and config_differences(ck_cfg, new):
@@ -98,15 +69,56 @@ def member_plan(cfg_data: dict[str, Any], d: Path) -> tuple[str, Any]:
     return "resume", None
 
 
+@runs.releases_folders
 def run_member(cfg_data: dict[str, Any], out: str, stop_event: str | None = None
                ) -> dict[str, Any]:
     """The task of one member (idempotent, retry-safe): decide from the folder's state --
     finished (return its summary), resumable (resume from the checkpoint) or neither (start
     over) -- then run with one numba thread. Returns the finished summary."""
-    from tribodem.braking.cli import _run_one
-
     what, info = member_plan(cfg_data, Path(out))
     if what == "done":
         return info
-    return _run_one(cfg_data, out, 1, resume=what == "resume",
-                    should_stop=stop_check(stop_event))
+    return run_in_folder(cfg_data, out, 1, resume=what == "resume",
+                         should_stop=stop_check(stop_event))
+
+
+def sweep_members(base: dict[str, Any], packings: int, out: Path,
+                  conditions: list[int]) -> list[Member]:
+    """The sweep's members, each config checked (ConfigError) before anything is made.
+    Folders: ``condition_k`` with one packing, else ``condition_k/seed_s`` (packing s,
+    geometry seed ``seed + s``; the folder name is kept from the former ``--seeds``, so
+    earlier sweeps are skipped/resumed, not redone); ``conditions`` of table 4. Key:
+    (condition, packing); ``info``: the condition and the packing."""
+    seed0 = int(base["geometry"]["seed"])
+    members = []
+    for s in range(packings):
+        for k in conditions:
+            data = merge(base, {"condition": {"index": k}, "geometry": {"seed": seed0 + s}})
+            setup_from_config(validate(BrakingConfig, data, source="sweep"))
+            d = out / f"condition_{k}" if packings == 1 else out / f"condition_{k}" / f"seed_{s}"
+            members.append(Member(key=(k, s), label=f"condition {k} packing {s}",
+                                  task_name=f"braking-c{k}-p{s}", task=run_member, data=data,
+                                  folder=d, info={"condition": k, "packing": s}))
+    return members
+
+
+def plan_members(members: list[Member], out: Path, echo: Callable[[str], None]
+                 ) -> tuple[dict[Any, dict[str, Any]], list[Member]]:
+    """(summaries of the members finished earlier with the same config, by key; the
+    members to run), each member's plan told through ``echo`` (skipped, resuming, starting
+    over and why)."""
+    results: dict[Any, dict[str, Any]] = {}
+    todo = []
+    for m in members:
+        what, info = member_plan(m.data, m.folder)
+        name = m.folder.relative_to(out)
+        if what == "done":
+            results[m.key] = info
+            echo(f"  {name}: finished earlier, skipped")
+        else:
+            if what == "resume":
+                echo(f"  {name}: resuming from its checkpoint")
+            elif info:
+                echo(f"  {name}: starting over ({info})")
+            todo.append(m)
+    return results, todo

@@ -36,7 +36,7 @@ from typing import Any
 import numpy as np
 
 from tribodem.braking.measure import Reference
-from tribodem.braking.model import DISC, EJECTED, PAD, Interface, _pairs_periodic
+from tribodem.braking.model import DISC, EJECTED, PAD, Interface, pairs_periodic
 from tribodem.braking.outlet import Outlet
 from tribodem.dem import ParallelBonds
 from tribodem.dem.state import FIX_X, FIX_Y
@@ -159,7 +159,7 @@ class Feed:
         reach = 2.0 * float(max(p.radius.max(), rad.max())) + gap
         old = np.flatnonzero((p.group == grp) & (np.abs(bpos[:, 1] - seam) < 2 * reach))
         ids = np.concatenate([old, p.n + np.arange(rad.size)])
-        i, j, _ = _pairs_periodic(np.concatenate([bpos[old], ext]),
+        i, j, _ = pairs_periodic(np.concatenate([bpos[old], ext]),
                                   np.concatenate([p.radius[old], rad]), iface.block.width, gap)
         i, j = ids[i], ids[j]
         new = (i >= p.n) | (j >= p.n)

@@ -31,8 +31,8 @@ Definitions (reference state = the loaded interface at the start of sliding):
 - **remaining thickness** (per body): the solid area of the body's matrix and
   delaminated-layer particles outside its anchored layer over ``phi W`` (m): the mean
   thickness of body left between the anchored boundary layer and the sliding interface
-  (a delaminated slab still stands between them and carries the load). ``run`` stops a
-  run whose body is worn through (``WORN_THROUGH``).
+  (a delaminated slab still stands between them and carries the load). A run stops
+  when a body is worn through (``tribodem.braking.setup.WORN_THROUGH``).
 - **wear depth, max** (per body): the deepest initial position of a worn particle's
   far edge below the body's initial mean surface (disc: ``s0 - (y0 - r)``; pad:
   ``(y0 + r) - s0``), clipped at 0; ``s0`` = mean over x-bins (2 r_max wide) of the
@@ -55,6 +55,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from tribodem.braking.model import DISC, EJECTED, PAD, Interface
+
+#: the measured columns added after checkpoints were first written: the rows of an older
+#: checkpoint hold no value of them (nan there, not zero)
+REMAINING = ("remaining_thickness_disc_m", "remaining_thickness_pad_m")
 
 
 @dataclass

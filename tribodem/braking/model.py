@@ -34,6 +34,7 @@ Boundary conditions (figure 8):
 
 from __future__ import annotations
 
+import functools
 import math
 import warnings
 from dataclasses import dataclass, field
@@ -212,16 +213,38 @@ def compact_periodic(spec: MaterialSpec, width: float, height: float, seed: int,
     fresh body, ``braking.feed``); y in [0, ``height``). Returns (pos, radii, stats)."""
     gap = spec.bond_gap if gap is None else gap
     for longer in (1, 2, 4, 8):
-        pos, radii, stats = _compact_once(spec, width, height, seed, stress, max_iter, gap,
+        pos, radii, stats = compact_once(spec, width, height, seed, stress, max_iter, gap,
                                           longer, periodic_y)
         if stats["loose_fraction"] <= LOOSE_MAX:
             break
     return pos, radii, stats
 
 
-def _compact_once(spec: MaterialSpec, width: float, height: float, seed: int, stress: float,
-                  max_iter: int, gap: float, longer: int, periodic_y: bool = False
-                  ) -> tuple[np.ndarray, np.ndarray, dict[str, float]]:
+def _relax(pos: np.ndarray, r: np.ndarray, steps: int, *, mat: Material, box: Box,
+           width: float, height: float, thickness: float, scale: int, periodic_y: bool
+           ) -> tuple[np.ndarray, float]:
+    """One relaxation of the compaction (``compact_by_radius_scaling``'s callback): the
+    disks at ``pos`` with radii ``r`` (m) for ``steps`` x ``scale`` steps between two
+    walls (or periodic in y); returns the positions and the mean stress (Pa) on the walls
+    (periodic: the virial stress)."""
+    t = thickness
+    walls = [] if periodic_y else [PlaneWall([0, 0, 0], [0, 1, 0], name="bottom"),
+                                   PlaneWall([0, height, 0], [0, -1, 0], name="top")]
+    part = ParticleState(dim=2, pos=pos, radius=r, density=mat.density, thickness=t)
+    sim = Simulation(part, [mat], box, walls=walls, local_damping=0.7, dt_safety=0.2)
+    sim.step(steps * scale)
+    if periodic_y:
+        c = sim.contacts()
+        dist = r[c["i"]] + r[c["j"]] - c["overlap"]
+        sig = float((c["normal_force"] * dist).sum()) / (2.0 * width * height * t)
+    else:
+        sig = 0.5 * (walls[0].normal_force + walls[1].normal_force) / (width * t)
+    return sim.p.pos.copy(), sig
+
+
+def compact_once(spec: MaterialSpec, width: float, height: float, seed: int, stress: float,
+                 max_iter: int, gap: float, longer: int, periodic_y: bool = False
+                 ) -> tuple[np.ndarray, np.ndarray, dict[str, float]]:
     """One compaction of ``compact_periodic`` with relaxations ``longer`` x its nominal
     steps."""
     rng = np.random.default_rng(seed)
@@ -242,26 +265,13 @@ def _compact_once(spec: MaterialSpec, width: float, height: float, seed: int, st
         box = Box([0.0, -2 * rmax, 0.0], [width, height + 2 * rmax, 0.0], [True, False, False])
 
     scale = max(1, round(width / height)) * longer * (4 if periodic_y else 1)
-
-    def relax(pos: np.ndarray, r: np.ndarray, steps: int) -> tuple[np.ndarray, float]:
-        walls = [] if periodic_y else [PlaneWall([0, 0, 0], [0, 1, 0], name="bottom"),
-                                       PlaneWall([0, height, 0], [0, -1, 0], name="top")]
-        part = ParticleState(dim=2, pos=pos, radius=r, density=mat.density, thickness=t)
-        sim = Simulation(part, [mat], box, walls=walls, local_damping=0.7, dt_safety=0.2)
-        sim.step(steps * scale)
-        if periodic_y:
-            c = sim.contacts()
-            dist = r[c["i"]] + r[c["j"]] - c["overlap"]
-            sig = float((c["normal_force"] * dist).sum()) / (2.0 * width * height * t)
-        else:
-            sig = 0.5 * (walls[0].normal_force + walls[1].normal_force) / (width * t)
-        return sim.p.pos.copy(), sig
-
+    relax = functools.partial(_relax, mat=mat, box=box, width=width, height=height,
+                              thickness=t, scale=scale, periodic_y=periodic_y)
     pos, alpha, sig, n_iter = compact_by_radius_scaling(
         relax, pos, radii, f0, stress, spec.effective_modulus, max_iter, growth=1.004)
     if periodic_y:
         pos[:, 1] = np.mod(pos[:, 1], height)
-    i, j, _ = _pairs_periodic(pos, radii * alpha, width, gap,
+    i, j, _ = pairs_periodic(pos, radii * alpha, width, gap,
                               height if periodic_y else None)
     deg = np.bincount(np.concatenate([i, j]), minlength=n)
     return pos, radii * alpha, {"compaction_iterations": float(n_iter),
@@ -296,8 +306,8 @@ def profile_height(x: np.ndarray, width: float, prof: tuple[np.ndarray, ...]) ->
                                 + ph)).sum(axis=1)
 
 
-def _pairs_periodic(pos: np.ndarray, radius: np.ndarray, width: float, gap: float,
-                    height: float | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def pairs_periodic(pos: np.ndarray, radius: np.ndarray, width: float, gap: float,
+                   height: float | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Pairs (i < j) with surface gap < ``gap`` (m), periodic in x (and in y with period
     ``height`` when given); returns (i, j, gap)."""
     if height is None:
@@ -434,6 +444,12 @@ class PadBacking:
         self.reaction = float(state.out[0])
 
     @property
+    def reaction_buffer(self) -> np.ndarray:
+        """The one-entry array (N) the compiled form writes the dashpots' reaction to; a
+        compiled piece that sums the plate force reads it in the same step."""
+        return self._out
+
+    @property
     def force(self) -> float:
         """Total force of the plate on the pad now (N): wall contacts + dashpots."""
         return float(self.wall.normal_force + self.reaction)
@@ -445,6 +461,60 @@ class PadBacking:
     def set_state(self, s: dict[str, np.ndarray]) -> None:
         """Restore what ``state`` returned."""
         self.reaction, self.wall.target_force = (float(x) for x in s["backing"])
+
+
+def _check_build(pressure_Pa: float, wall_mass_ratio: float, backing: str,
+                 plate_areal_mass: float | None, block: str) -> None:
+    """``ValueError`` naming the first argument of :func:`build_interface` it cannot use."""
+    if block not in ("walls", "periodic"):
+        raise ValueError(f"block = {block!r}: must be 'walls' or 'periodic'")
+    if not pressure_Pa > 0:
+        raise ValueError(f"pressure_Pa = {pressure_Pa!r}: must be > 0 Pa")
+    if not 0 < wall_mass_ratio <= 1000:
+        raise ValueError(f"wall_mass_ratio = {wall_mass_ratio!r}: must be in (0, 1000]")
+    if plate_areal_mass is not None and not plate_areal_mass > 0:
+        raise ValueError(f"plate_areal_mass = {plate_areal_mass!r}: must be > 0 kg/m^2")
+    if backing not in ("absorbing", "support"):
+        raise ValueError(f"backing = {backing!r}: must be 'absorbing' or 'support'")
+
+
+def _cut_bodies(pos: np.ndarray, radii: np.ndarray, g: Geometry, gap: float
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray,
+                           np.ndarray, float, float]:
+    """The compacted block (positions, radii, m) cut along two random profiles into the
+    disc (below) and the pad (above), the particles between them removed, the same-body
+    pairs within the bond gap ``gap`` (m) bonded, the particles left without a bond
+    dropped. Returns positions, radii, groups, each particle's index in the block, the
+    bonds' ends (i, j), the pad's lift (m: the profiles' largest overlap) and the count
+    of particles removed."""
+    w = g.width
+    rng = np.random.default_rng(g.seed + 7919)
+    prof_d = rough_profile(rng, w, g.amplitude, g.modes, g.first_mode)
+    prof_p = rough_profile(rng, w, g.amplitude, g.modes, g.first_mode)
+    x, y = pos[:, 0], pos[:, 1]
+    y_mid = g.disc_height + g.amplitude
+    hd = y_mid + profile_height(x, w, prof_d)
+    xs = np.linspace(0.0, w, 2049)
+    lift = float((profile_height(xs, w, prof_d) - profile_height(xs, w, prof_p)).max())
+    hp = y_mid + lift + profile_height(x, w, prof_p)
+    is_disc = y < hd
+    is_pad = y > hp
+    keep = is_disc | is_pad
+    src = np.flatnonzero(keep)  # each kept particle's index in the block
+    pos, radii, is_pad = pos[keep], radii[keep], is_pad[keep]
+    group = np.where(is_pad, PAD, DISC).astype(np.int32)
+    # bonds: same-body pairs within the bond gap (section 3.1); bodies not bonded together
+    bi, bj, _ = pairs_periodic(pos, radii, w, gap)
+    same = group[bi] == group[bj]
+    bi, bj = bi[same], bj[same]
+    # drop particles without a bond (floaters of the cut)
+    deg = np.bincount(np.concatenate([bi, bj]), minlength=radii.size)
+    ok = deg > 0
+    idx = np.cumsum(ok) - 1
+    keep2 = ok[bi] & ok[bj]
+    bi, bj = idx[bi[keep2]], idx[bj[keep2]]
+    removed = float(keep.size - keep.sum() + (~ok).sum())
+    return pos[ok], radii[ok], group[ok], src[ok], bi, bj, lift, removed
 
 
 def build_interface(geometry: Geometry, pressure_Pa: float, micro: str = "calibrated",
@@ -460,16 +530,7 @@ def build_interface(geometry: Geometry, pressure_Pa: float, micro: str = "calibr
     periodic in y too (``"periodic"``: the disc's bottom face and the pad's top face are
     then one seamless plane of the block, so copies of it continue either body without a
     seam: the feed, ``braking.feed``)."""
-    if block not in ("walls", "periodic"):
-        raise ValueError(f"block = {block!r}: must be 'walls' or 'periodic'")
-    if not pressure_Pa > 0:
-        raise ValueError(f"pressure_Pa = {pressure_Pa!r}: must be > 0 Pa")
-    if not 0 < wall_mass_ratio <= 1000:
-        raise ValueError(f"wall_mass_ratio = {wall_mass_ratio!r}: must be in (0, 1000]")
-    if plate_areal_mass is not None and not plate_areal_mass > 0:
-        raise ValueError(f"plate_areal_mass = {plate_areal_mass!r}: must be > 0 kg/m^2")
-    if backing not in ("absorbing", "support"):
-        raise ValueError(f"backing = {backing!r}: must be 'absorbing' or 'support'")
+    _check_build(pressure_Pa, wall_mass_ratio, backing, plate_areal_mass, block)
     disc, pad = materials(micro)
     rmax = max(disc.radius_range[1], pad.radius_range[1])
     geometry.check(rmax)
@@ -489,32 +550,7 @@ def build_interface(geometry: Geometry, pressure_Pa: float, micro: str = "calibr
                       f"neighbour within the bond gap and are dropped (a jammed packing: "
                       f"<= {100 * LOOSE_MAX:.0f} %)", stacklevel=2)
     phi_c = float(math.pi * (radii**2).sum() / (w * total))
-    rng = np.random.default_rng(g.seed + 7919)
-    prof_d = rough_profile(rng, w, g.amplitude, g.modes, g.first_mode)
-    prof_p = rough_profile(rng, w, g.amplitude, g.modes, g.first_mode)
-    x, y = pos[:, 0], pos[:, 1]
-    y_mid = g.disc_height + g.amplitude
-    hd = y_mid + profile_height(x, w, prof_d)
-    xs = np.linspace(0.0, w, 2049)
-    lift = float((profile_height(xs, w, prof_d) - profile_height(xs, w, prof_p)).max())
-    hp = y_mid + lift + profile_height(x, w, prof_p)
-    is_disc = y < hd
-    is_pad = y > hp
-    keep = is_disc | is_pad
-    src = np.flatnonzero(keep)  # each kept particle's index in the block
-    pos, radii, is_pad = pos[keep], radii[keep], is_pad[keep]
-    group = np.where(is_pad, PAD, DISC).astype(np.int32)
-    # bonds: same-body pairs within the bond gap (section 3.1); bodies not bonded together
-    bi, bj, _ = _pairs_periodic(pos, radii, w, gap)
-    same = group[bi] == group[bj]
-    bi, bj = bi[same], bj[same]
-    # drop particles without a bond (floaters of the cut)
-    deg = np.bincount(np.concatenate([bi, bj]), minlength=radii.size)
-    ok = deg > 0
-    idx = np.cumsum(ok) - 1
-    keep2 = ok[bi] & ok[bj]
-    bi, bj = idx[bi[keep2]], idx[bj[keep2]]
-    pos, radii, group, src = pos[ok], radii[ok], group[ok], src[ok]
+    pos, radii, group, src, bi, bj, lift, removed = _cut_bodies(pos, radii, g, gap)
     block_pos = blk.pos[src].copy() if blk is not None else None
     # pad down rigidly until the closest disc-pad surface gap is the clearance
     pd = group == PAD
@@ -555,7 +591,7 @@ def build_interface(geometry: Geometry, pressure_Pa: float, micro: str = "calibr
     if backing == "absorbing":
         back = PadBacking(sim, wall, np.flatnonzero(anchor_pad), pad, w)
         sim.add_interaction(back)
-    stats.update({"removed_by_cut": float(keep.size - keep.sum() + (~ok).sum()),
+    stats.update({"removed_by_cut": removed,
                   "particles": float(part.n), "bonds": float(bonds.n_bonds),
                   "bonds_per_particle": 2.0 * bonds.n_bonds / part.n,
                   "profile_lift_m": lift, "packing_fraction": phi_c,

@@ -34,7 +34,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from tribodem.braking.measure import partition
 from tribodem.braking.model import EJECTED, Interface
+from tribodem.dem.state import FIX_ROTATION, FIX_TRANSLATION
 
 
 class Outlet:
@@ -78,8 +80,6 @@ class Outlet:
     def check(self, iface: Interface) -> int:
         """Update the travel of the debris and eject the components that went
         ``length``; returns the number of particles ejected now."""
-        from tribodem.braking.measure import partition
-
         p = iface.sim.p
         w = iface.width
         x = p.pos[:, 0]
@@ -106,8 +106,6 @@ class Outlet:
 
     def _store(self, iface: Interface, members: np.ndarray) -> None:
         """Move one component rigidly into the store and freeze it."""
-        from tribodem.dem.state import FIX_ROTATION, FIX_TRANSLATION
-
         p = iface.sim.p
         w = iface.width
         r = p.radius[members]

@@ -35,14 +35,12 @@ def _disks(ax: Any, pos: np.ndarray, radius: np.ndarray, values: np.ndarray, cma
     fig.colorbar(col, ax=ax, label=label, shrink=0.8)
 
 
-def plot_run(out: Path, rows: list[dict[str, float]], frames: dict[str, dict[str, np.ndarray]],
-             iface: Interface, summary: dict[str, Any]) -> None:
-    """Write displacement.png (fig 11/16), velocity.png (fig 13), force_chains.png (fig 17)
-    and wear_history.png (figs 12, 18)."""
+def _plot_displacement(out: Path, frames: dict[str, dict[str, np.ndarray]], w: float
+                       ) -> None:
+    """displacement.png (figs 11, 16): magnitude (um) in the body frames of the early and
+    end frames, detached particles marked; ``w``: the cell width (m)."""
     plt = _plt()
-    w = iface.width
     keys = [k for k in ("early", "end") if k in frames]
-    # displacement field (figs 11, 16): magnitude in the body frames, detached outlined
     fig, axes = plt.subplots(1, len(keys), figsize=(6.5 * len(keys), 5.0), squeeze=False)
     for ax, k in zip(axes[0], keys, strict=True):
         fr = frames[k]
@@ -58,8 +56,11 @@ def plot_run(out: Path, rows: list[dict[str, float]], frames: dict[str, dict[str
         ax.legend(loc="upper right", fontsize=7)
     fig.tight_layout()
     write_figure(out / "displacement.png", fig)
-    # velocity vectors (fig 13), disc frame-free: lab velocities
-    fr = frames["end"]
+
+
+def _plot_velocity(out: Path, fr: dict[str, np.ndarray], w: float) -> None:
+    """velocity.png (fig 13): the velocity vectors (m/s, lab frame) of frame ``fr``."""
+    plt = _plt()
     live = fr["group"] != EJECTED
     pos = fr["pos"][live].copy()
     pos[:, 0] = np.mod(pos[:, 0], w)
@@ -75,9 +76,14 @@ def plot_run(out: Path, rows: list[dict[str, float]], frames: dict[str, dict[str
     ax.set_title("velocity vectors at the end (lab frame; disc at -v)")
     fig.tight_layout()
     write_figure(out / "velocity.png", fig)
-    # force chains (fig 17): black compression, red tension, width ~ |F|
+
+
+def _plot_chains(out: Path, fr: dict[str, np.ndarray], w: float) -> None:
+    """force_chains.png (fig 17) of frame ``fr``: strong compressive chains black, tensile
+    red, width ~ |F|; weak ones grey."""
     from matplotlib.collections import LineCollection
 
+    plt = _plt()
     fig, ax = plt.subplots(figsize=(8, 5.5))
     i, j, f = fr["chain_i"], fr["chain_j"], fr["chain_f"]
     a, b = fr["pos"][i, :2], fr["pos"][j, :2].copy()
@@ -103,7 +109,12 @@ def plot_run(out: Path, rows: list[dict[str, float]], frames: dict[str, dict[str
                  fontsize=9)
     fig.tight_layout()
     write_figure(out / "force_chains.png", fig)
-    # histories (figs 12, 18)
+
+
+def _plot_history(out: Path, rows: list[dict[str, float]], summary: dict[str, Any]) -> None:
+    """wear_history.png (figs 12, 18): depths (um), bonds and debris, force chains, the
+    plate's pressure (MPa) and displacement (um) against the simulated time (us)."""
+    plt = _plt()
     t = np.array([r["time_s"] for r in rows]) * 1e6
     fig, axes = plt.subplots(2, 2, figsize=(10, 7))
     ax = axes[0, 0]
@@ -135,3 +146,14 @@ def plot_run(out: Path, rows: list[dict[str, float]], frames: dict[str, dict[str
                  f"{summary['sliding_speed_m_s']:.4g} m/s")
     fig.tight_layout()
     write_figure(out / "wear_history.png", fig)
+
+
+def plot_run(out: Path, rows: list[dict[str, float]], frames: dict[str, dict[str, np.ndarray]],
+             iface: Interface, summary: dict[str, Any]) -> None:
+    """Write displacement.png (fig 11/16), velocity.png (fig 13), force_chains.png (fig 17)
+    and wear_history.png (figs 12, 18) into folder ``out``."""
+    w = iface.width
+    _plot_displacement(out, frames, w)
+    _plot_velocity(out, frames["end"], w)
+    _plot_chains(out, frames["end"], w)
+    _plot_history(out, rows, summary)

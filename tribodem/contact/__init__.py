@@ -6,13 +6,17 @@ fretting cycles by :class:`tribodem.fretting.FrettingLoop`. Backends, registered
 ``elastic`` :class:`HalfSpaceSolver` (elastic half-space BEM on tamaas) and
 ``elastic-plastic`` :class:`ElastoPlasticSolver` (tamaas EPIC, bilinear EN24T), ``fe``
 :class:`FEContactSolver` (CalculiX, plane strain) and ``fe3d`` :class:`FE3DContactSolver`
-(CalculiX, 3D crossed cylinders).
+(CalculiX, 3D crossed cylinders). Each backend is built from a resolved case
+(:class:`ContactCase`) and the config tables it reads (:attr:`FirstBodySolver.options`:
+``[plastic]`` :class:`~tribodem.contact.options.PlasticOptions`, ``[fe]``
+:class:`~tribodem.contact.fe.options.FEOptions`) by :meth:`FirstBodySolver.from_case`.
 """
 
 from tribodem.contact.base import (
     CAPABILITY_TEXT,
     VOIGT_ORDER,
     Capabilities,
+    ContactCase,
     ElasticBody,
     FirstBodySolver,
     IncrementResult,
@@ -55,6 +59,7 @@ __all__ = [
     "CAPABILITY_TEXT",
     "VOIGT_ORDER",
     "Capabilities",
+    "ContactCase",
     "ElasticBody",
     "ElastoPlasticSolver",
     "FE3DContactSolver",

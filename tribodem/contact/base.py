@@ -22,14 +22,19 @@ from __future__ import annotations
 
 import math
 from abc import ABC, abstractmethod
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
-from typing import Any, Literal
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, ClassVar, Literal, cast
 
 import numpy as np
 from numpy.typing import NDArray
+from pydantic import BaseModel
 
 from tribodem.materials.en24t import EN24T
+
+if TYPE_CHECKING:
+    from typing import Self
 
 #: A body's recession below its tangent plane at (x, y), m (callable or height map).
 Recession = Callable[[NDArray[np.float64], NDArray[np.float64]], NDArray[np.float64]]
@@ -40,8 +45,14 @@ BODIES: tuple[Body, ...] = ("upper", "lower")
 #: Voigt order of the stress components returned by :class:`SubsurfaceStress`.
 VOIGT_ORDER = ("xx", "yy", "zz", "yz", "xz", "xy")
 
+#: ``[fe]`` fields whose None (left out) means the backend's own default, which differs
+#: between the CalculiX backends (``OWN_DEFAULTS`` of each)
+BACKEND_OWN = ("h_over_a", "size_factor", "timeout")
 
-def _check_positive(name: str, value: float, allow_zero: bool = False) -> float:
+
+def check_positive(name: str, value: float, allow_zero: bool = False) -> float:
+    """``value`` as a float, finite and > 0 (>= 0 with ``allow_zero``); else ``ValueError``
+    naming ``name``, the value and the rule."""
     v = float(value)
     ok = v >= 0.0 if allow_zero else v > 0.0
     if not math.isfinite(v) or not ok:
@@ -58,7 +69,7 @@ class ElasticBody:
     poisson: float = EN24T.poisson  #: Poisson's ratio, -
 
     def __post_init__(self) -> None:
-        _check_positive("young", self.young)
+        check_positive("young", self.young)
         if not (-1.0 < float(self.poisson) < 0.5):
             raise ValueError(f"poisson = {self.poisson!r} is not allowed: must be in (-1, 0.5)")
 
@@ -88,6 +99,28 @@ def dundurs_beta(a: ElasticBody, b: ElasticBody) -> float:
     k1 = (1 - 2 * a.poisson) / a.shear - (1 - 2 * b.poisson) / b.shear
     k2 = (1 - a.poisson) / a.shear + (1 - b.poisson) / b.shear
     return 0.5 * k1 / k2
+
+
+@dataclass(frozen=True)
+class ContactCase:
+    """The resolved first-body case every backend is built from (SI)."""
+
+    upper: Recession  #: recession of the upper body below its tangent plane, m
+    lower: Recession  #: recession of the lower body, m
+    upper_material: ElasticBody  #: the upper body's elastic constants
+    lower_material: ElasticBody  #: the lower body's elastic constants
+    load: float  #: total normal load on the window, N
+    friction: float  #: Coulomb friction coefficient, -
+    amplitude: float  #: displacement amplitude of the cycle, m
+    n_increments: int  #: increments per cycle (a multiple of 4)
+    n: int  #: window points per side
+    window: float | None  #: window side, m (None: the backend's estimate)
+    regime: str = "gross"  #: half-space slip regime ("gross" or "ciavarella-jaeger")
+    tolerance: float = 1e-6  #: half-space normal solver (PKR) tolerance, -
+    #: "point" / "line" of an analytic geometry, None for height maps (found from them)
+    contact: str | None = None
+    #: depth of the subsurface stress grid the criterion asks for, m (None: the backend's)
+    stress_depth: float | None = None
 
 
 @dataclass
@@ -202,10 +235,21 @@ class FirstBodySolver(ABC):
     - debris (``debris``): :meth:`set_debris_pressure`, :attr:`debris_pressure`,
       :attr:`debris_load`, :meth:`loaded_solution`;
     - resume: :meth:`state_dict` / :meth:`load_state_dict`;
-    - options and reports: :meth:`capabilities_for` (the capabilities of a configured
-      instance), :meth:`options_for`, :meth:`report` (for summary.json).
+    - building and options: :meth:`from_case` (a :class:`ContactCase`
+      and the config tables of :attr:`options`), :meth:`capabilities_for` (the capabilities
+      of a configured instance), :meth:`options_for`, :meth:`effective_options`;
+    - reports: :meth:`report` (for summary.json).
     """
 
+    #: the backend's name in :data:`tribodem.contact.BACKENDS` (for messages)
+    name: ClassVar[str] = ""
+    #: the config tables the backend reads, by TOML table name, and their models
+    #: (:meth:`from_case` takes them)
+    options: ClassVar[dict[str, type[BaseModel]]] = {}
+    #: whether the backend runs CalculiX jobs (then a run gives it a :attr:`workdir`)
+    runs_ccx: ClassVar[bool] = False
+    #: the folder of the backend's own files (the ccx jobs; None: none, or a temporary one)
+    workdir: Path | None = None
     #: what this backend can give (class attribute of each backend)
     capabilities: Capabilities = Capabilities()
     #: window grid spacing (m) and number of points per side
@@ -229,14 +273,75 @@ class FirstBodySolver(ABC):
     @property
     def coords(self) -> NDArray[np.float64]:
         """Window point coordinates along x or y relative to the window centre, m."""
-        return (np.arange(self.n) - self.n // 2) * self.dx
+        return ((np.arange(self.n) - self.n // 2) * self.dx).astype(np.float64, copy=False)
+
+    @property
+    def ny(self) -> int:
+        """Window points along y: ``n`` (a square window), 1 for a backend that solves one
+        cross-section of a line contact (its fields are ``[n, 1]``)."""
+        return self.n
+
+    @property
+    def dy(self) -> float:
+        """Extent along y of one window point, m: ``dx``, or the window's side for a
+        cross-section that stands for the whole window (so that a field x ``dx dy``
+        integrates over the same area in both)."""
+        return self.dx
+
+    @property
+    def coords_y(self) -> NDArray[np.float64]:
+        """Window point coordinates along y, m (``coords``; ``[0]`` for a cross-section)."""
+        return self.coords if self.ny == self.n else np.zeros(self.ny)
 
     @classmethod
-    def capabilities_for(cls, options: dict[str, Any]) -> Capabilities:
-        """What an instance built with ``options`` (its config table, e.g. ``[fe]``) can
-        give; checked before any work. Default: :attr:`capabilities` (no option changes it)."""
+    def from_case(cls, case: ContactCase, options: Mapping[str, BaseModel] | None = None
+                  ) -> Self:
+        """The backend on ``case``, configured by ``options`` (config tables by TOML name,
+        those of :attr:`options`; a table left out takes its model's defaults).
+
+        ``tribodem.io.config.ConfigError`` for an option the backend cannot use (naming the
+        dotted field, the value and what is allowed), ``ValueError`` for a case it cannot
+        solve, ``tribodem.contact.fe.ccx.CcxNotFoundError`` for a ccx backend without ccx.
+        Default: the constructor called as ``cls(upper, lower, **case_keywords(case))``."""
+        del options
+        factory = cast("Callable[..., Self]", cls)
+        return factory(case.upper, case.lower, **cls.case_keywords(case))
+
+    @classmethod
+    def case_keywords(cls, case: ContactCase) -> dict[str, Any]:
+        """The contract's constructor keywords of ``case``: ``load`` (N), ``friction``,
+        ``upper_material``, ``lower_material``, ``n``, ``window`` (m or None), ``regime``,
+        ``tolerance``, and ``contact`` for a backend that solves line contacts and an
+        analytic geometry (None, found from the surfaces, otherwise)."""
+        kw: dict[str, Any] = dict(
+            load=case.load, friction=case.friction, upper_material=case.upper_material,
+            lower_material=case.lower_material, n=case.n, window=case.window,
+            regime=case.regime, tolerance=case.tolerance)
+        if "line" in cls.capabilities.contacts and case.contact is not None:
+            kw["contact"] = case.contact
+        return kw
+
+    @classmethod
+    def capabilities_for(cls, options: Mapping[str, BaseModel] | None = None
+                         ) -> Capabilities:
+        """What an instance built with ``options`` (config tables by TOML name, as
+        :meth:`from_case` takes them) can give; checked before any work. Default:
+        :attr:`capabilities` (no option changes it)."""
         del options
         return cls.capabilities
+
+    @classmethod
+    def effective_options(cls, options: Mapping[str, Mapping[str, Any]]
+                          ) -> dict[str, dict[str, Any]]:
+        """The option tables ``options`` (JSON dicts by TOML name) as this backend takes
+        them, for telling whether two recorded configs make the same run. Default: every
+        table as given, but the ``[fe]`` fields whose None means a ccx backend's own default
+        (:data:`BACKEND_OWN`) left out: they do nothing here."""
+
+        out = {table: dict(fields) for table, fields in options.items()}
+        if "fe" in out:
+            out["fe"] = {k: v for k, v in out["fe"].items() if k not in BACKEND_OWN}
+        return out
 
     @classmethod
     def options_for(cls, names: set[str]) -> str:
@@ -351,7 +456,7 @@ def cycle_offsets(amplitude: float, n_increments: int) -> NDArray[np.float64]:
 
     ``n_increments`` must be a positive multiple of 4 (equal steps of 4 A / n).
     """
-    _check_positive("amplitude", amplitude)
+    check_positive("amplitude", amplitude)
     if int(n_increments) != n_increments or n_increments < 4 or n_increments % 4:
         raise ValueError(
             f"n_increments = {n_increments!r} is not allowed: must be a multiple of 4, >= 4"

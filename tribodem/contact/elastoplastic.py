@@ -35,8 +35,9 @@ tractions on the conformed surfaces).
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 import tamaas as tm
@@ -47,19 +48,26 @@ from tribodem.contact.base import (
     Capabilities,
     IncrementResult,
     SubsurfaceStress,
-    _check_positive,
+    check_positive,
 )
 from tribodem.contact.geometry import Recession
 from tribodem.contact.halfspace import (
     HalfSpaceSolver,
-    _estimate_contact_radius,
+    estimate_contact_radius,
     model_fields,
     set_model_fields,
 )
+from tribodem.contact.options import PlasticOptions, option_table
+from tribodem.io.config import ConfigError
 from tribodem.materials.en24t import EN24T
 
 if TYPE_CHECKING:
+    from typing import Self
+
+    from pydantic import BaseModel
     from scipy.interpolate import RegularGridInterpolator
+
+    from tribodem.contact.base import ContactCase
 
 #: EN24T (seed table 5.1): yield and ultimate tensile strength, Pa.
 YIELD_EN24T = EN24T.yield_strength
@@ -84,7 +92,7 @@ def bilinear_hardening(young: float, yield_strength: float, uts: float, uts_stra
     h = E E_t / (E - E_t) (EN24T defaults: E_t 2.48 GPa, h 2.50 GPa)."""
     for name, v in (("young", young), ("yield_strength", yield_strength), ("uts", uts),
                     ("uts_strain", uts_strain)):
-        _check_positive(name, v)
+        check_positive(name, v)
     if uts <= yield_strength:
         raise ValueError(f"uts = {uts!r} is not allowed: must exceed yield_strength "
                          f"= {yield_strength!r} Pa")
@@ -141,8 +149,25 @@ class ElastoPlasticSolver(HalfSpaceSolver):
     Both bodies must be of the same material.
     """
 
+    name = "elastic-plastic"
+    options: ClassVar[dict[str, type[BaseModel]]] = {"plastic": PlasticOptions}
     capabilities = Capabilities(plastic=True, partial_slip=True, subsurface=True, debris=True,
                                 contacts=("point",))
+
+    @classmethod
+    def from_case(cls, case: ContactCase, options: Mapping[str, BaseModel] | None = None
+                  ) -> Self:
+        """The solver on ``case`` with the ``[plastic]`` table's law and EP grid
+        (:class:`~tribodem.contact.options.PlasticOptions`; its defaults when left out).
+        ``ConfigError`` for ``plastic.beyond_uts = 'hold'``: tamaas's linear hardening goes
+        on past the UTS."""
+        plastic = option_table(options, "plastic", PlasticOptions)
+        if plastic.beyond_uts != "line":
+            raise ConfigError(
+                f"plastic.beyond_uts = {plastic.beyond_uts!r}: solver = {cls.name!r} "
+                "has linear hardening only (it goes on past the UTS); allowed: 'line', or "
+                "solver = 'fe' or 'fe3d' with [fe] material = 'elastic-plastic'")
+        return cls(case.upper, case.lower, **cls.case_keywords(case), **plastic.model_dump())
 
     def __init__(
         self,
@@ -176,10 +201,10 @@ class ElastoPlasticSolver(HalfSpaceSolver):
                              "hardening goes on past the UTS; allowed: 'line' (or a ccx "
                              "solver, fe or fe3d, for 'hold')")
         mat = self.upper_material
-        self.yield_strength = _check_positive("yield_strength", yield_strength)
+        self.yield_strength = check_positive("yield_strength", yield_strength)
         if hardening is None:
             hardening = bilinear_hardening(mat.young, yield_strength, uts, uts_strain)
-        self.hardening = _check_positive("hardening", hardening, allow_zero=True)
+        self.hardening = check_positive("hardening", hardening, allow_zero=True)
         for name, v in (("ep_n", ep_n), ("ep_nz", ep_nz), ("load_steps", load_steps),
                         ("ep_max_iter", ep_max_iter)):
             if int(v) != v or v < 1:
@@ -190,13 +215,13 @@ class ElastoPlasticSolver(HalfSpaceSolver):
             raise ValueError(f"ep_nz = {ep_nz!r} is not allowed: must be >= 3")
         self.ep_n, self.ep_nz = int(ep_n), int(ep_nz)
         self.load_steps, self.ep_max_iter = int(load_steps), int(ep_max_iter)
-        self.ep_tolerance = _check_positive("ep_tolerance", ep_tolerance)
+        self.ep_tolerance = check_positive("ep_tolerance", ep_tolerance)
         #: re-solve EPIC at full load at every cycle start (off: ratchets in tamaas 2.9)
         self.reload_cycles = bool(reload_cycles)
         #: Hertz contact radius of the unworn surfaces, m (the EP length unit)
-        self.a_hertz = _estimate_contact_radius(self.upper, self.lower, self.load, self.modulus)
-        self.ep_window = _check_positive("ep_window_radii", ep_window_radii) * self.a_hertz
-        self.ep_depth = _check_positive("ep_depth_radii", ep_depth_radii) * self.a_hertz
+        self.a_hertz = estimate_contact_radius(self.upper, self.lower, self.load, self.modulus)
+        self.ep_window = check_positive("ep_window_radii", ep_window_radii) * self.a_hertz
+        self.ep_depth = check_positive("ep_depth_radii", ep_depth_radii) * self.a_hertz
         if self.ep_window > self.window:
             raise ValueError(
                 f"ep_window_radii = {ep_window_radii!r} gives an EP window of "
@@ -216,7 +241,8 @@ class ElastoPlasticSolver(HalfSpaceSolver):
     @property
     def ep_coords(self) -> NDArray[np.float64]:
         """Coarse EP grid x (= y) coordinates, m (lab frame at offset 0)."""
-        return (np.arange(self.ep_n) - self.ep_n // 2) * self.ep_dx
+        return ((np.arange(self.ep_n) - self.ep_n // 2) * self.ep_dx).astype(np.float64,
+                                                                                copy=False)
 
     @property
     def ep_z(self) -> NDArray[np.float64]:

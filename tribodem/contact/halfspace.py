@@ -36,28 +36,33 @@ Model (seed 003 sections 3.3 and 6.1, replacing the Abaqus FE phase):
 from __future__ import annotations
 
 import math
-from typing import Any, Literal
+from collections.abc import Mapping
+from typing import Any, ClassVar, Literal
 
 import numpy as np
 import tamaas as tm
 from numpy.typing import NDArray
+from pydantic import BaseModel
 
 from tribodem.contact.base import (
     BODIES,
     Body,
     Capabilities,
+    ContactCase,
     ElasticBody,
     FirstBodySolver,
     IncrementResult,
     SubsurfaceStress,
     WindowTooSmallError,
-    _check_positive,
+    check_positive,
     checked_debris_pressure,
     contact_modulus,
     dundurs_beta,
     mindlin_kappa,
 )
 from tribodem.contact.geometry import HertzSphere, Recession, crossed_cylinders, line_window
+from tribodem.contact.line import LineContactSolver
+from tribodem.contact.options import ElasticOptions, option_table
 
 tm.set_log_level(tm.LogLevel.error)
 
@@ -100,7 +105,7 @@ def _curvatures(upper: Recession, lower: Recession) -> tuple[float, float]:
     return kx, ky
 
 
-def _estimate_contact_radius(
+def estimate_contact_radius(
     upper: Recession, lower: Recession, load: float, modulus: float
 ) -> float:
     """Hertz contact radius from the curvatures of the summed recession at the origin, m."""
@@ -133,8 +138,24 @@ class HalfSpaceSolver(FirstBodySolver):
     ``regime`` must be ``"gross"``.
     """
 
+    name = "elastic"
     capabilities = Capabilities(partial_slip=True, subsurface=True, debris=True,
                                 contacts=("point", "line"))
+    options: ClassVar[dict[str, type[BaseModel]]] = {"elastic": ElasticOptions}
+
+    @classmethod
+    def from_case(cls, case: ContactCase, options: Mapping[str, BaseModel] | None = None
+                  ) -> FirstBodySolver:
+        """The elastic backend on ``case``. A line contact of an analytic geometry
+        (``case.contact == "line"``, a cylinder on a flat) is solved on one cross-section
+        with the plane-strain influence function (:class:`LineContactSolver`) unless
+        ``[elastic] line_model = "periodic-2d"`` (:class:`ElasticOptions`) asks for this
+        class's n x n window periodic along the cylinder's axis; everything else here."""
+        elastic = option_table(options, "elastic", ElasticOptions)
+        if cls is HalfSpaceSolver and case.contact == "line" and \
+                elastic.line_model == "plane-strain":
+            return LineContactSolver.from_case(case)
+        return super().from_case(case, options)
 
     def __init__(
         self,
@@ -156,8 +177,8 @@ class HalfSpaceSolver(FirstBodySolver):
         if upper is None or lower is None:
             upper, lower = crossed_cylinders()
         self.upper, self.lower = upper, lower
-        self.load = _check_positive("load", load)
-        self.friction = _check_positive("friction", friction, allow_zero=True)
+        self.load = check_positive("load", load)
+        self.friction = check_positive("friction", friction, allow_zero=True)
         self.upper_material = upper_material or ElasticBody()
         self.lower_material = lower_material or ElasticBody()
         if int(n) != n or n < 16 or n % 2:
@@ -169,14 +190,14 @@ class HalfSpaceSolver(FirstBodySolver):
                 "'ciavarella-jaeger' (partial slip after reversals)"
             )
         self.regime = regime
-        self.tolerance = _check_positive("tolerance", tolerance)
+        self.tolerance = check_positive("tolerance", tolerance)
         self.modulus = contact_modulus(self.upper_material, self.lower_material)
         self.beta = dundurs_beta(self.upper_material, self.lower_material)
         if contact not in (None, "point", "line"):
             raise ValueError(f"contact = {contact!r} is not allowed: use 'point', 'line' or "
                              "None (found from the surfaces)")
         if window is None:
-            k = _check_positive("window_radii", window_radii)
+            k = check_positive("window_radii", window_radii)
             kx, ky = _curvatures(upper, lower)
             if contact == "line" or (contact is None and kx > 0 and ky == 0.0):
                 if not kx > 0:
@@ -185,8 +206,8 @@ class HalfSpaceSolver(FirstBodySolver):
                                      " give window (m) explicitly")
                 window = line_window(1.0 / kx, self.load, self.modulus, k)
             else:
-                window = k * _estimate_contact_radius(upper, lower, self.load, self.modulus)
-        self.dx = _check_positive("window", window) / self.n
+                window = k * estimate_contact_radius(upper, lower, self.load, self.modulus)
+        self.dx = check_positive("window", window) / self.n
         g0 = HalfSpaceSolver.gap(self, 0.0)  # the surfaces alone (no subclass additions)
         along_y = float(np.ptp(g0, axis=1).max())
         flat_y = along_y <= 1e-12 * max(float(np.ptp(g0)), 1e-300)
@@ -478,7 +499,7 @@ class HalfSpaceSolver(FirstBodySolver):
             depth = 3.0 * max(result.contact_area, self.dx**2) / (2.0 * self.window)
         elif depth is None:
             depth = 3.0 * math.sqrt(max(result.contact_area, self.dx**2) / math.pi)
-        depth = _check_positive("depth", depth)
+        depth = check_positive("depth", depth)
         mat = self.upper_material if body == "upper" else self.lower_material
         sign = 1.0 if body == "upper" else -1.0
         nz = int(nz)

@@ -70,6 +70,7 @@ def halfspace_checks(n: int = 128) -> list[dict[str, Any]]:
         q = -float(step.traction[..., 0].sum()) * cj.dx**2
         mindlin = MU * LOAD * (1 - (1 - frac) ** 1.5)
         out.append(check(f"mindlin Q at {frac} delta* (N)", q, mindlin, 0.03))
+        assert step.stick is not None  # ciavarella-jaeger: stick and slip
         c = math.sqrt(float(step.stick.sum()) * cj.dx**2 / math.pi)
         out.append(check(f"mindlin stick radius at {frac} delta* (m)", c,
                          hz.contact_radius * (1 - q / (MU * LOAD)) ** (1 / 3), 0.05))

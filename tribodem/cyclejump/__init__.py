@@ -1,12 +1,19 @@
 """tribodem.cyclejump: cycle-jumping (seed 003 chapter 4 and appendix III; eq 2.20).
 
-``strategies`` (the five strategies behind :class:`JumpStrategy`, error-controlled steps,
-:func:`replay` and the synthetic series), ``cli`` (``tribodem jump replay``).
+``strategies`` (the strategies of the thesis behind :class:`JumpStrategy`, error-controlled
+steps, :func:`replay` and the synthetic series), ``smooth`` (:class:`SmoothJump`, the default
+``adaptive``: steps judged on a local fit of the underlying curve), ``registry``
+(:data:`STRATEGIES` by name, :func:`make_strategy`), ``recorded`` (a recorded
+``cycle,increment`` CSV:
+:func:`read_increments_csv`, :func:`replay_csv` as ``tribodem jump replay`` does it,
+:func:`plot_replay`), ``cli`` (``tribodem jump replay``).
 """
 
+from tribodem.cyclejump.recorded import plot_replay, read_increments_csv, replay_csv
+from tribodem.cyclejump.registry import STRATEGIES, make_strategy
+from tribodem.cyclejump.smooth import SmoothJump
 from tribodem.cyclejump.strategies import (
     SMOOTH_SHAPES,
-    STRATEGIES,
     AdaptiveDiagnostics,
     AdaptiveJump,
     CojocaruJump,
@@ -16,7 +23,6 @@ from tribodem.cyclejump.strategies import (
     OverlappingGroupsJump,
     ReplayResult,
     error_controlled_jump,
-    make_strategy,
     replay,
     synthetic_smooth_series,
     synthetic_two_phase_series,
@@ -35,9 +41,13 @@ __all__ = [
     "MovingGroupsJump",
     "OverlappingGroupsJump",
     "ReplayResult",
+    "SmoothJump",
     "error_controlled_jump",
     "make_strategy",
+    "plot_replay",
+    "read_increments_csv",
     "replay",
+    "replay_csv",
     "synthetic_smooth_series",
     "synthetic_two_phase_series",
     "transition_end",

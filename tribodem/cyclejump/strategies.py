@@ -27,7 +27,7 @@ reads ``Result.csv``), and :func:`synthetic_two_phase_series` makes a running-in
 test series (seed figure 5.17); :func:`synthetic_smooth_series` makes linear, power-law,
 exponential run-in and two-phase series.
 
-Step control (issue 13): every strategy but ``constant`` (opt-in there) bounds its jump
+Step control: every strategy but ``constant`` (opt-in there) bounds its jump
 with :func:`error_controlled_jump`, the longest jump whose predicted local error stays
 within a relative tolerance ``tol`` of the extrapolated increment, using the curvature of
 the rates measured on simulated cycles (never on extrapolated ones). ``step_control=
@@ -602,7 +602,7 @@ class AdaptiveJump(JumpStrategy):
     error estimate is used, which is then conservative.
     """
 
-    name = "adaptive"
+    name = "polynomial"
 
     def __init__(
         self,
@@ -863,24 +863,6 @@ class AdaptiveJump(JumpStrategy):
         if self.taylor_order == 2:
             inc = inc + 0.5 * n * n * d2
         return inc
-
-
-STRATEGIES: dict[str, type[JumpStrategy]] = {
-    "constant": ConstantJump,
-    "cojocaru": CojocaruJump,
-    "moving": MovingGroupsJump,
-    "overlapping": OverlappingGroupsJump,
-    "adaptive": AdaptiveJump,
-}
-
-
-def make_strategy(name: str, **params: Any) -> JumpStrategy:
-    """Build a strategy by name with keyword parameters (unknown keys raise TypeError)."""
-    try:
-        cls = STRATEGIES[name]
-    except KeyError:
-        raise ValueError(f"unknown strategy {name!r}; allowed: {', '.join(STRATEGIES)}") from None
-    return cls(**params)
 
 
 @dataclass

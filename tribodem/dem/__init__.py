@@ -10,12 +10,19 @@ servo walls), ``integrate`` (central difference with damping, time-step estimate
 ``bonds`` (linear parallel bonds, breakage log), ``thermal`` (temperature, expansion,
 conduction through intact bonds), ``clumps`` (rigid multi-sphere debris bodies),
 ``trimesh`` (rigid triangle-mesh surfaces, e.g. from STL).
+
+From Python, :func:`run` is ``tribodem dem run`` (``demo``: the settling / compression
+demo, config :class:`DemRunConfig` in ``config``), returning a
+:class:`~tribodem.io.record.RunResult`; ``bench`` measures throughput (``tribodem bench
+dem``).
 """
 
 from tribodem.dem import laws
 from tribodem.dem.bonds import BondBreak, ParallelBonds, install_bonds_by_gap
 from tribodem.dem.clumps import Clumps, ClumpTemplate, debris_template, make_clumps
+from tribodem.dem.config import DemRunConfig
 from tribodem.dem.contact import Material
+from tribodem.dem.demo import run
 from tribodem.dem.engine import Simulation
 from tribodem.dem.errors import SimulationUnstable, TimeStepError
 from tribodem.dem.space import Box
@@ -29,6 +36,7 @@ __all__ = [
     "Box",
     "ClumpTemplate",
     "Clumps",
+    "DemRunConfig",
     "Material",
     "ParallelBonds",
     "ParticleState",
@@ -42,4 +50,5 @@ __all__ = [
     "install_bonds_by_gap",
     "laws",
     "make_clumps",
+    "run",
 ]

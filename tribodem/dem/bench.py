@@ -125,3 +125,35 @@ def _peak_rss() -> float:
     import resource
 
     return float(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss) * 1024.0
+
+
+#: ``bench dem --quick``: particles and steps when not given.
+QUICK_PARTICLES, QUICK_STEPS = 2000, 200
+
+
+def benchmark(case: str = "settle3d", *, quick: bool = False, particles: int | None = None,
+              steps: int | None = None, threads: int | None = None) -> dict[str, Any]:
+    """What ``tribodem bench dem`` measures: :func:`run_case` after checking the case, the
+    threads against the cores and the particles against the memory (``ConfigError`` naming
+    the option, the value and what is allowed). ``quick``: :data:`QUICK_PARTICLES`
+    particles and :data:`QUICK_STEPS` steps unless given."""
+    from tribodem.dem.state import BYTES_PER_PARTICLE
+    from tribodem.io import runs
+    from tribodem.io.config import ConfigError
+
+    if case not in CASES:
+        raise ConfigError(f"bench dem: --case = {case!r}: must be one of {sorted(CASES)}")
+    if quick:
+        particles = particles or QUICK_PARTICLES
+        steps = steps or QUICK_STEPS
+    if threads is not None:
+        runs.check_threads(threads, "--threads", zero_means_all=False)
+    if particles is not None:
+        runs.check_memory(particles, BYTES_PER_PARTICLE, "--particles")
+    return run_case(case, n=particles, steps=steps, threads=threads)
+
+
+def describe(res: dict[str, Any]) -> str:
+    """One line of a :func:`benchmark` result: case, size, threads, particle-steps/s."""
+    return (f"{res['case']}: {res['particles']} particles x {res['steps']} steps on "
+            f"{res['threads']} thread(s): {res['particle_steps_per_s']:.3e} particle-steps/s")

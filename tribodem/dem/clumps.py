@@ -45,7 +45,7 @@ from numba import njit, prange
 
 from tribodem.dem.integrate import BLOCK, drift_of, local_damped
 from tribodem.dem.jit import kernel
-from tribodem.dem.neighbors import NeighborList, _reverse
+from tribodem.dem.neighbors import NeighborList, reverse_index
 from tribodem.dem.state import FIX_CLUMP, FIX_ROTATION, FIX_TRANSLATION, ParticleState
 
 DEBRIS_SHAPES = ("spherical", "chunk", "rubbing")
@@ -530,7 +530,7 @@ class Clumps:
         pj = nl.pair_j[keep]
         start = np.zeros(n + 1, dtype=np.int64)
         np.cumsum(np.bincount(pi, minlength=n), out=start[1:])
-        rs, rp = _reverse(n, pj)
+        rs, rp = reverse_index(n, pj)
         return NeighborList(start, pi, pj, rs, rp, nl.ref_pos, nl.ref_radius, nl.skin,
                             nl.builds)
 

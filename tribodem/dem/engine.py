@@ -11,8 +11,9 @@ from __future__ import annotations
 
 import json
 import math
+from collections.abc import Mapping
 from pathlib import Path
-from typing import Protocol
+from typing import Any, Protocol
 
 import numba
 import numpy as np
@@ -217,8 +218,8 @@ def _pairs_update(pos, vel, omega, radius, mass, inertia, mat, fixed, start, pai
     the particles whose pairs it summed, in the same region: the separate update region
     (equal particle counts, while the pair cuts are by work) handed ~10 % of settle3d's
     particles from one thread to the other every step, which cost 3.5 % when the VM's two
-    vCPUs sit on different L3 caches (BENCHMARKS.md, session 40). The same operations on
-    each particle as the serial loop: the same bits."""
+    vCPUs sit on different L3 caches (BENCHMARKS.md, bonded3d on two threads). The same
+    operations on each particle as the serial loop: the same bits."""
     nt = (bounds.shape[0] - 1) // BLOCKS_PER_THREAD
     for t in numba.prange(nt):
         for b in range(t * BLOCKS_PER_THREAD, (t + 1) * BLOCKS_PER_THREAD):
@@ -1018,8 +1019,14 @@ class Simulation:
                 "pairs_per_particle": self.nl.n_pairs / n, "total_bytes": float(bp + bq)}
 
     # ------------------------------------------------------------------ checkpoints
-    def save_checkpoint(self, path: str | Path) -> Path:
-        """Write the full state atomically (``.npz``): resuming gives bitwise the same run."""
+    def save_checkpoint(self, path: str | Path, record: Mapping[str, Any] | None = None
+                        ) -> Path:
+        """Write the full state atomically (``.npz``): resuming gives bitwise the same run.
+
+        ``record``: what the caller keeps beside the state (JSON-able; a run's resolved
+        config, :func:`tribodem.io.record.checkpoint_meta`), read back with
+        :func:`read_checkpoint_record`; :meth:`load_checkpoint` does not look at it.
+        """
         arrays: dict[str, np.ndarray] = {f"p_{k}": v for k, v in self.p.arrays().items()}
         arrays.update({
             "nl_start": self.nl.start, "nl_pair_i": self.nl.pair_i, "nl_pair_j": self.nl.pair_j,
@@ -1042,6 +1049,8 @@ class Simulation:
                 "n": self.p.n}
         arrays["meta"] = np.array(json.dumps(meta))
         arrays["time_exact"] = np.array([self.time])
+        if record is not None:
+            arrays["record"] = np.array(json.dumps(dict(record)))
         return write_npz(path, **arrays)
 
     def load_checkpoint(self, path: str | Path) -> None:
@@ -1085,3 +1094,14 @@ class Simulation:
             self._evaluated = self.step_count > 0
             self.time = float(z["time_exact"][0])
             self.dt = float(meta["dt"])
+
+
+def read_checkpoint_record(path: str | Path) -> dict[str, Any] | None:
+    """The ``record`` a checkpoint was saved with (:meth:`Simulation.save_checkpoint`), or
+    None when it has none (saved without one, or by an older tribodem). Raises what numpy
+    raises for a file that is not a readable ``.npz``."""
+    with np.load(path, allow_pickle=False) as z:
+        if "record" not in z.files:
+            return None
+        record = json.loads(str(z["record"]))
+    return record if isinstance(record, dict) else None

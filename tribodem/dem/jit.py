@@ -8,7 +8,7 @@ Threading layer: OpenMP first (``THREADING_LAYER_PRIORITY``), unless the user na
 with ``NUMBA_THREADING_LAYER``. numba's own order puts TBB first, and with the TBB that
 Debian installs beside Yade a threaded region took ~100 us to launch against ~2 us for
 OpenMP (measured here, idle, 2 cores), which cost a 2-thread step of 20,000 spheres
-about 15 % (BENCHMARKS.md, session 15).
+about 15 % (BENCHMARKS.md, the threading-layer measurements).
 """
 
 from __future__ import annotations

@@ -239,7 +239,7 @@ def _bucket(keys, nkeys):
 
 
 @njit(cache=True)
-def _reverse(n, pj):
+def reverse_index(n, pj):
     """Reverse index of a half list: for each particle, the pairs in which it is second."""
     return _bucket(pj, n)
 
@@ -276,7 +276,7 @@ def build(pos: np.ndarray, radius: np.ndarray, skin: float, box_lo: np.ndarray,
         scan(pos, radius, skin, length, periodic, cell, cstart, order, ncell, start, pj, True)
         _sort_rows.pick(n)(start, pj)
     pi = _owner(start, pj.size)
-    rs, rp = _reverse(n, pj)
+    rs, rp = reverse_index(n, pj)
     return NeighborList(start, pi, pj, rs, rp, pos.copy(), radius.copy(), float(skin),
                         builds + 1)
 

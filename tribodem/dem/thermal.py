@@ -19,6 +19,7 @@ Heat reaching a particle changes its temperature only; there is no heat of frict
 from __future__ import annotations
 
 import csv
+import math
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -50,21 +51,34 @@ def conduct(temp, cstart, cbond, bi, bj, mode, resistance, mass, heat_cap, dt, o
 
 
 def read_curve(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
-    """Read a temperature curve CSV with two columns, time (s) and T (K); a header row is
-    skipped. Returns (times, temperatures)."""
+    """Read a temperature curve CSV with two columns, time (s) and T (K); a header row and
+    ``#`` comments are skipped. Returns (times, temperatures). ``ValueError`` naming the
+    file and the row for anything else: a file that cannot be read or is not text, a row
+    that is not two finite numbers, times that do not increase, a temperature <= 0 K."""
     rows = []
-    with open(path, newline="") as fh:
-        for row in csv.reader(fh):
-            if not row or row[0].strip().startswith("#"):
-                continue
-            try:
-                rows.append((float(row[0]), float(row[1])))
-            except ValueError:
-                if rows:
-                    raise ValueError(f"curve '{path}': row {row!r} is not two numbers") from None
+    try:
+        with open(path, newline="", encoding="utf-8") as fh:
+            for n, row in enumerate(csv.reader(fh), start=1):
+                if not row or not "".join(row).strip() or row[0].strip().startswith("#"):
+                    continue
+                try:
+                    t, temp = float(row[0]), float(row[1])
+                except (ValueError, IndexError):
+                    if rows or n > 1:
+                        raise ValueError(f"curve '{path}': row {n} {row!r} is not two numbers "
+                                         "(time s, temperature K)") from None
+                    continue  # a header
+                if not (math.isfinite(t) and math.isfinite(temp)) or temp <= 0.0:
+                    raise ValueError(f"curve '{path}': row {n} {row!r}: allowed: a finite "
+                                     "time (s) and a temperature > 0 K")
+                rows.append((t, temp))
+    except (OSError, UnicodeDecodeError, csv.Error) as err:
+        raise ValueError(f"curve '{path}': cannot be read as a CSV text file: {err}") from None
     if not rows:
-        raise ValueError(f"curve '{path}': no (time, T) rows")
+        raise ValueError(f"curve '{path}': no (time s, temperature K) rows")
     a = np.array(rows)
+    if np.any(np.diff(a[:, 0]) <= 0):
+        raise ValueError(f"curve '{path}': the times do not increase from row to row")
     return a[:, 0], a[:, 1]
 
 

@@ -55,11 +55,22 @@ class TrackGrid:
     Upper body: the solver window itself (``x_upper`` = window coordinates). Lower body:
     ``n + 2 pad`` x-points; window point ``i`` at offset ``s`` sits on track point
     ``pad + i + s / dx`` (between two track points when ``s / dx`` is not an integer).
+    Along y both grids have the window's ``ny`` points of extent ``dy`` (left out: ``n``
+    and ``dx``, a square window; a line contact solved on one cross-section: 1 point that
+    stands for the window's side).
     """
 
     n: int
     dx: float
     pad: int
+    ny: int = 0  #: points along y (0: ``n``)
+    dy: float = 0.0  #: extent of a point along y, m (0: ``dx``)
+
+    def __post_init__(self) -> None:
+        if self.ny <= 0:
+            self.ny = self.n
+        if self.dy <= 0.0:
+            self.dy = self.dx
 
     @property
     def n_track(self) -> int:
@@ -75,18 +86,41 @@ class TrackGrid:
 
     @property
     def y(self) -> NDArray[np.float64]:
-        return self.x_upper
+        """Coordinates of the points along y, m (0 for a single cross-section)."""
+        return (np.arange(self.ny) - self.ny // 2) * self.dy if self.ny > 1 else np.zeros(1)
 
     @property
     def cell_area(self) -> float:
-        return self.dx * self.dx
+        """Surface area one grid point stands for, m^2 (``dx dy``)."""
+        return self.dx * self.dy
+
+    @property
+    def upper_shape(self) -> tuple[int, int]:
+        """Shape of a field on the upper body's grid (the window): ``(n, ny)``."""
+        return self.n, self.ny
+
+    @property
+    def lower_shape(self) -> tuple[int, int]:
+        """Shape of a field on the lower body's track: ``(n_track, ny)``."""
+        return self.n_track, self.ny
 
     def deposit(self, track: NDArray[np.float64], field: NDArray[np.float64],
                 inc: IncrementResult) -> None:
         """Add a window field ``[..., n, n]`` onto ``track`` ``[..., n_track, n]`` at the
-        increment's mid position, split linearly between the two neighbouring shifts
-        (conservative; same rule as :class:`FrettingCycle`)."""
-        shift = 0.5 * (inc.offset + inc.start_offset) / self.dx
+        position where it was solved, the increment's end offset ``s`` (m), split linearly
+        between the two neighbouring track shifts ``floor(s / dx)`` and the next
+        (conservative: the sum is kept).
+
+        The increment's field (e.g. pressure x slip) is the integrand of the wear over the
+        slide sampled at ``s``: each sample belongs on the lower body where the contact was
+        when it was solved (the quadrature of wear = sum over samples of field(x - s_k)).
+        The split is the transpose of the linear interpolation through which the solver
+        sees the lower body's worn surface at ``s``, so a wear feature is fed back onto
+        itself (a stable, self-levelling response). Deposited anywhere else (the
+        increment's mid position, half a step away) the feedback of a two-grid-point
+        ripple changes sign and the ripple grows into a saw-tooth whenever the step is not
+        a whole number of grid points (docs/fretting.md, "Sampling of the stroke")."""
+        shift = inc.offset / self.dx
         k = int(math.floor(shift))
         w = shift - k
         j0 = self.pad + k
@@ -239,8 +273,8 @@ class RateCriterion(Criterion):
 
     def begin_cycle(self, grid: TrackGrid, solver: FirstBodySolver) -> None:
         super().begin_cycle(grid, solver)
-        self._up = np.zeros((grid.n, grid.n))
-        self._lo = np.zeros((grid.n_track, grid.n))
+        self._up = np.zeros(grid.upper_shape)
+        self._lo = np.zeros(grid.lower_shape)
 
     def add_increment(self, index: int, inc: IncrementResult) -> None:
         f = self.local_rate(inc)
@@ -379,8 +413,8 @@ class ThresholdCriterion(Criterion):
         if self._n_increments == 0:
             raise RuntimeError("set_increments() must be called before the first cycle")
         self._idx = self.sample_indices()
-        self._up = np.full((self.nz, grid.n, grid.n), -np.inf)
-        self._lo = np.full((self.nz, grid.n_track, grid.n), -np.inf)
+        self._up = np.full((self.nz, *grid.upper_shape), -np.inf)
+        self._lo = np.full((self.nz, *grid.lower_shape), -np.inf)
         self._z: NDArray[np.float64] | None = None
         self._seg: tuple[float, float] | None = None  # slide since the last sample, m
         self._prev: tuple[float, NDArray[np.float64]] | None = None  # its offset, lower field
@@ -589,8 +623,8 @@ class DFDICriterion(Criterion):
             self.depth = float(solver.plastic_depth)
         self._z = np.linspace(0.0, self.depth, self.nz)
         if self._d_up is None:
-            self._d_up = np.zeros((self.nz, grid.n, grid.n))
-            self._d_lo = np.zeros((self.nz, grid.n_track, grid.n))
+            self._d_up = np.zeros((self.nz, *grid.upper_shape))
+            self._d_lo = np.zeros((self.nz, *grid.lower_shape))
 
     def add_increment(self, index: int, inc: IncrementResult) -> None:
         """Plastic flow happens in the solver's load steps (collected in ``depths``)."""
@@ -770,12 +804,12 @@ class SWTCriterion(ThresholdCriterion):
             raise RuntimeError("set_increments() must be called before the first cycle")
         self._idx = sorted(self.sample_indices())
         s = len(self._idx)
-        self._h_up = np.zeros((s, self.nz, grid.n, grid.n, 6), dtype=np.float32)
-        self._h_lo = np.zeros((s, self.nz, grid.n_track, grid.n, 6), dtype=np.float32)
+        self._h_up = np.zeros((s, self.nz, *grid.upper_shape, 6), dtype=np.float32)
+        self._h_lo = np.zeros((s, self.nz, *grid.lower_shape, 6), dtype=np.float32)
         self._z = None
         if self._d_up is None:
-            self._d_up = np.zeros((self.nz, grid.n, grid.n))
-            self._d_lo = np.zeros((self.nz, grid.n_track, grid.n))
+            self._d_up = np.zeros((self.nz, *grid.upper_shape))
+            self._d_lo = np.zeros((self.nz, *grid.lower_shape))
 
     def add_increment(self, index: int, inc: IncrementResult) -> None:
         if index not in self._idx:
@@ -822,8 +856,8 @@ class SWTCriterion(ThresholdCriterion):
 
         # the upper body's contact centre (section 6.6: "the material at the centre of the
         # contact zone obtained very small values"): the grid's central 2 x 2 columns
-        c = self.grid.n // 2
-        centre = (slice(None), slice(c - 1, c + 1), slice(c - 1, c + 1))
+        c, cy = self.grid.n // 2, self.grid.ny // 2
+        centre = (slice(None), slice(c - 1, c + 1), slice(max(cy - 1, 0), cy + 1))
         return _remove_damaged(self, {
             "cycles_to_first_wear_upper": first_wear(self._d_up, r_up),
             "cycles_to_first_wear_upper_centre": first_wear(self._d_up[centre], r_up[centre]),

@@ -55,6 +55,26 @@ DEBRIS_COLUMNS = (
 )
 
 
+class WornProfile:
+    """A wear profile along x on a single cross-section (a line contact solved on one
+    section, grids ``[n, 1]``): ``wear(x, y)`` interpolated linearly along x, the same at
+    every y; 0 outside the profile is refused like a :class:`HeightMap` refuses points
+    off its map."""
+
+    def __init__(self, values: NDArray[np.float64], dx: float, x0: float) -> None:
+        self.values = np.asarray(values, dtype=float).reshape(-1)
+        self.x = x0 + dx * np.arange(self.values.size)
+        self.dx = dx
+
+    def __call__(self, x: NDArray[np.float64], y: NDArray[np.float64]) -> NDArray[np.float64]:
+        x = np.asarray(x, dtype=float)
+        tol = 1e-9 * self.dx
+        if x.min() < self.x[0] - tol or x.max() > self.x[-1] + tol:
+            raise ValueError(f"wear profile covers x in [{self.x[0]:.4g}, {self.x[-1]:.4g}] m "
+                             f"but was sampled on [{x.min():.4g}, {x.max():.4g}] m")
+        return np.interp(x, self.x, self.values) + 0.0 * np.asarray(y, dtype=float)
+
+
 class WornSurface:
     """Recession of a worn body: ``base(x, y) + wear(x, y)`` (m), wear a :class:`HeightMap`."""
 
@@ -74,10 +94,13 @@ class FrettingHistory:
     grid: TrackGrid
     wear_upper: NDArray[np.float64]  #: cumulative wear depth, m, [n, n]
     wear_lower: NDArray[np.float64]  #: cumulative wear depth, m, [n_track, n]
-    profiles_upper: list[NDArray[np.float64]]  #: wear at the central section per row, m
+    profiles_upper: list[NDArray[np.float64]]  #: wear at the central section, m
     profiles_lower: list[NDArray[np.float64]]
     base_upper: NDArray[np.float64]  #: unworn recession at the central section, m
     base_lower: NDArray[np.float64]
+    #: the cycles of the profiles: five spread over the run (those ``profiles.png`` plots,
+    #: for every number of cycles the run was asked for) and the newest
+    profile_cycles: list[int] = field(default_factory=list)
     cycles_simulated: int = 0
     cycles_jumped: int = 0
     wall_time_s: float = 0.0
@@ -112,7 +135,8 @@ class FrettingHistory:
             "wear_depth_mean_scar_upper_m": _scar_mean(self.wear_upper),
             "wear_depth_mean_scar_lower_m": _scar_mean(self.wear_lower),
             "dissipated_energy_total_J": self.cumulative_energy,
-            "grid": {"n": self.grid.n, "dx_m": self.grid.dx, "n_track": self.grid.n_track},
+            "grid": {"n": self.grid.n, "dx_m": self.grid.dx, "n_track": self.grid.n_track,
+                     "ny": self.grid.ny, "dy_m": self.grid.dy},
             "criterion_last_cycle": self.criterion_info,
             **({"debris": self.debris_summary()} if self.debris is not None else {}),
         }
@@ -183,32 +207,34 @@ class FrettingLoop:
         self.strategy = strategy
         criterion.set_increments(n_increments)
         n, dx = solver.n, solver.dx
-        self.grid = TrackGrid(n=n, dx=dx, pad=int(math.ceil(self.amplitude / dx)) + 1)
+        self.grid = TrackGrid(n=n, dx=dx, pad=int(math.ceil(self.amplitude / dx)) + 1,
+                              ny=solver.ny, dy=solver.dy)
         self.base_upper: Recession = solver.upper
         self.base_lower: Recession = solver.lower
-        self.wear_upper = np.zeros((n, n))
-        self.wear_lower = np.zeros((self.grid.n_track, n))
+        self.wear_upper = np.zeros(self.grid.upper_shape)
+        self.wear_lower = np.zeros(self.grid.lower_shape)
         if int(debris_every) != debris_every or debris_every < 1:
             raise ValueError(f"debris_every = {debris_every!r}: must be an integer >= 1 cycle")
         self.debris = debris
         self.debris_every = int(debris_every)
         self.de_phases: list[DEPhaseResult] = []
         self._cycle = 0
-        self._p_load = np.zeros((n, n))  # total pressure at the loading position, Pa
+        self._p_load = np.zeros(self.grid.upper_shape)  # pressure at the loading position, Pa
         self.history: FrettingHistory | None = None  #: set by the first loading
-        #: what stopped this session's run early (``history.stopped`` is its text)
+        #: what stopped this process's run early (``history.stopped`` is its text)
         self.stop_error: WindowTooSmallError | FESolverStopped | None = None
         self._done = 0  # cycles recorded (simulated + jumped)
         self._observe_pending = False  # last cycle of a finished run not shown to strategy
         self._last_per: dict[str, Any] = {}  # per-cycle values of the last simulated cycle
-        self._wall = 0.0  # wall time of earlier sessions (resumed runs), s
+        self._wall = 0.0  # wall time of the earlier processes of a resumed run, s
         #: jumps keep the geometry the next cycle sees: the jumped depth increment stays
         #: below this fraction of the contact's elastic approach (None: strategy alone)
         self.geometry_tolerance: float | None = geometry_tolerance
-        self._last_du = np.zeros((n, n))
-        self._last_dl = np.zeros((self.grid.n_track, n))
+        self._last_du = np.zeros(self.grid.upper_shape)
+        self._last_dl = np.zeros(self.grid.lower_shape)
         #: every jump decision so far (``jump_decisions``), for the summary
         self._decisions = _no_decisions()
+        self._keep: set[int] = set()  # cycles whose profiles stay recorded
 
     def _de_phase(self) -> dict[str, float]:
         """Seed 003 figure 3.1 DE step: load the debris, map its forces back to the solver."""
@@ -238,9 +264,15 @@ class FrettingLoop:
 
     def _apply_geometry(self) -> None:
         g = self.grid
-        y0 = float(g.y[0])
-        up = HeightMap(self.wear_upper, g.dx, g.dx, float(g.x_upper[0]), y0)
-        lo = HeightMap(self.wear_lower, g.dx, g.dx, float(g.x_lower[0]), y0)
+        up: Recession
+        lo: Recession
+        if g.ny == 1:  # one cross-section: the profiles along x
+            up = WornProfile(self.wear_upper, g.dx, float(g.x_upper[0]))
+            lo = WornProfile(self.wear_lower, g.dx, float(g.x_lower[0]))
+        else:
+            y0 = float(g.y[0])
+            up = HeightMap(self.wear_upper, g.dx, g.dy, float(g.x_upper[0]), y0)
+            lo = HeightMap(self.wear_lower, g.dx, g.dy, float(g.x_lower[0]), y0)
         self.solver.set_surfaces(WornSurface(self.base_upper, up),
                                  WornSurface(self.base_lower, lo))
 
@@ -325,20 +357,34 @@ class FrettingLoop:
             rows=[], grid=g, wear_upper=self.wear_upper, wear_lower=self.wear_lower,
             profiles_upper=[], profiles_lower=[],
             base_upper=np.asarray(self.base_upper(g.x_upper, np.zeros(g.n)), dtype=float),
-            base_lower=np.asarray(self.base_lower(g.x_lower, np.zeros(g.n_track)), dtype=float),
+            base_lower=np.asarray(self.base_lower(g.x_lower, np.zeros(g.n_track)),
+                                  dtype=float),
             debris=self.debris,
         )
 
     def _record(self, row: dict[str, Any],
                 progress: Callable[[dict[str, Any]], None] | None) -> None:
+        """Record a row and the central-section profiles of its cycle (the newest replaces
+        the one before it unless that one is among :meth:`plot_cycles`: a run of tens of
+        thousands of cycles keeps six profiles, not one per cycle)."""
         hist = self.history
         assert hist is not None
-        j = self.grid.n // 2
+        j = self.grid.ny // 2
         hist.rows.append(row)
+        if hist.profile_cycles and hist.profile_cycles[-1] not in self._keep:
+            for kept in (hist.profile_cycles, hist.profiles_upper, hist.profiles_lower):
+                kept.pop()
+        hist.profile_cycles.append(int(row["cycle"]))
         hist.profiles_upper.append(self.wear_upper[:, j].copy())
         hist.profiles_lower.append(self.wear_lower[:, j].copy())
         if progress is not None:
             progress(row)
+
+    @staticmethod
+    def plot_cycles(cycles: int, k: int = 5) -> set[int]:
+        """The cycles whose profiles a run keeps for ``profiles.png`` / ``profiles.csv``:
+        the first and ``k - 1`` evenly spaced up to ``cycles`` (the last among them)."""
+        return {1} | {max(1, round(cycles * j / (k - 1))) for j in range(1, k)}
 
     def _jump(self, c: int, cycles: int, per: dict[str, Any],
               progress: Callable[[dict[str, Any]], None] | None) -> int:
@@ -460,6 +506,7 @@ class FrettingLoop:
             "rows": list(hist.rows),
             "profiles_upper": list(hist.profiles_upper),
             "profiles_lower": list(hist.profiles_lower),
+            "profile_cycles": list(hist.profile_cycles),
             "cycles_simulated": hist.cycles_simulated,
             "cycles_jumped": hist.cycles_jumped,
             "jump_decisions": dict(self._decisions),
@@ -497,6 +544,10 @@ class FrettingLoop:
         hist.rows = list(state["rows"])
         hist.profiles_upper = list(state["profiles_upper"])
         hist.profiles_lower = list(state["profiles_lower"])
+        # checkpoints that kept a profile for every row did not name their cycles
+        hist.profile_cycles = list(state.get("profile_cycles")
+                                   or [int(r["cycle"]) for r in hist.rows])
+        self._keep = set(hist.profile_cycles)
         hist.cycles_simulated = int(state["cycles_simulated"])
         hist.cycles_jumped = int(state["cycles_jumped"])
         # checkpoints written before the decisions were counted have none
@@ -511,13 +562,16 @@ class FrettingLoop:
         progress: Callable[[dict[str, Any]], None] | None = None,
         checkpoint: Callable[[FrettingLoop], None] | None = None,
         checkpoint_every: int = 1,
+        checkpoint_seconds: float = 0.0,
     ) -> FrettingHistory:
         """Run up to cycle ``cycles`` (simulated or jumped) and return the history.
 
         The first call loads the bodies (normal loading at offset 0); a loop restored by
         :meth:`load_state_dict` (or run before) continues from where it is. ``progress`` is
         called with each recorded row; ``checkpoint(self)`` after every ``checkpoint_every``
-        simulated cycles (each with the jump that may follow it) and at the end. A contact
+        simulated cycles (each with the jump that may follow it) once ``checkpoint_seconds``
+        of wall time have passed since the last one (the first: after the first cycle),
+        and at the end. A contact
         that outgrows the solver window stops the run early (``history.stopped`` says why;
         rows so far are kept; no checkpoint is written for the unfinished cycle).
         """
@@ -534,6 +588,7 @@ class FrettingLoop:
                              "be an integer >= 1")
         t0 = time.perf_counter()
         cycles = int(cycles)
+        self._keep |= self.plot_cycles(cycles)
         if self.history is None:
             self.history = self._new_history()
             self.solver.reset()
@@ -557,6 +612,7 @@ class FrettingLoop:
             self._observe_pending = False
             c = self._done = self._jump(c, cycles, self._last_per, progress)
         since = 0
+        last_checkpoint = -math.inf
         while c < cycles:
             try:
                 per = self.simulate_cycle()
@@ -575,10 +631,13 @@ class FrettingLoop:
                     c = self._jump(c, cycles, per, progress)
             self._done = c
             since += 1
-            if checkpoint is not None and (since >= checkpoint_every or c >= cycles):
-                hist.wall_time_s = self._wall + time.perf_counter() - t0
+            now = time.perf_counter()
+            if checkpoint is not None and (c >= cycles or (
+                    since >= checkpoint_every and now - last_checkpoint >= checkpoint_seconds)):
+                hist.wall_time_s = self._wall + now - t0
                 checkpoint(self)
                 since = 0
+                last_checkpoint = now
         return self._finish(t0)
 
     def _finish(self, t0: float) -> FrettingHistory:

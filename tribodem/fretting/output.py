@@ -44,8 +44,28 @@ def write_results(hist: FrettingHistory, out: Path, extra: dict[str, Any]) -> di
     return summary
 
 
-def _profile_rows(n_rows: int, k: int = 5) -> list[int]:
-    return sorted({int(round(i)) for i in np.linspace(0, n_rows - 1, min(k, n_rows))})
+def _profile_rows(hist: FrettingHistory, k: int = 5) -> list[int]:
+    """Indices of the recorded profiles to show: ``k`` spread over the run, the last
+    among them."""
+    n = len(hist.profile_cycles)
+    return sorted({int(round(i)) for i in np.linspace(0, n - 1, min(k, n))}) if n else []
+
+
+def write_profiles(hist: FrettingHistory, out: Path) -> Path | None:
+    """``out/profiles.csv``: the worn profiles along the stroke at the central section
+    y = 0 (columns cycle, body, x_m, wear_depth_m; m), at the cycles ``profiles.png``
+    plots (five spread over the run, the last among them). None before the first cycle."""
+    if not hist.rows:
+        return None
+    g = hist.grid
+    rows: list[list[Any]] = []
+    for i in _profile_rows(hist):
+        cycle = hist.profile_cycles[i]
+        for body, x, profs in (("upper", g.x_upper, hist.profiles_upper),
+                               ("lower", g.x_lower, hist.profiles_lower)):
+            rows += [[cycle, body, float(xv), float(d)] for xv, d in zip(x, profs[i],
+                                                                         strict=True)]
+    return write_csv(out / "profiles.csv", ["cycle", "body", "x_m", "wear_depth_m"], rows)
 
 
 def write_figures(hist: FrettingHistory, out: Path) -> list[Path]:
@@ -68,8 +88,8 @@ def write_figures(hist: FrettingHistory, out: Path) -> list[Path]:
     ):
         top, bottom = axes[0, col], axes[1, col]
         top.plot(x * 1e3, -base * 1e6, "k--", label="unworn")
-        for i in _profile_rows(len(profs)):
-            lab = f"cycle {hist.rows[i]['cycle']}"
+        for i in _profile_rows(hist):
+            lab = f"cycle {hist.profile_cycles[i]}"
             top.plot(x * 1e3, -(base + profs[i]) * 1e6, label=lab)
             bottom.plot(x * 1e3, -profs[i] * 1e6, label=lab)
         top.set_ylabel("surface height (um)")
@@ -83,8 +103,10 @@ def write_figures(hist: FrettingHistory, out: Path) -> list[Path]:
     fig, axes = plt.subplots(1, 2, figsize=(10, 4))
     for ax, body, x, w in ((axes[0], "lower", g.x_lower, hist.wear_lower),
                            (axes[1], "upper", g.x_upper, hist.wear_upper)):
-        ext = (x[0] * 1e3, x[-1] * 1e3, g.y[0] * 1e3, g.y[-1] * 1e3)
-        im = ax.imshow(w.T * 1e6, origin="lower", extent=ext, aspect="equal", cmap="viridis")
+        half = 0.5 * g.dy  # a point stands for dy along y (one section: the window's side)
+        ext = (x[0] * 1e3, x[-1] * 1e3, (g.y[0] - half) * 1e3, (g.y[-1] + half) * 1e3)
+        im = ax.imshow(w.T * 1e6, origin="lower", extent=ext, cmap="viridis",
+                       aspect="equal" if g.ny > 1 else "auto")
         fig.colorbar(im, ax=ax, label="wear depth (um)")
         ax.set_xlabel("x (mm)")
         ax.set_ylabel("y (mm)")
@@ -114,15 +136,20 @@ def write_figures(hist: FrettingHistory, out: Path) -> list[Path]:
 
 
 def write_vtk_surfaces(hist: FrettingHistory, out: Path) -> list[Path]:
-    """Worn surfaces as VTK quad grids (points at z = -(recession + wear), m)."""
+    """Worn surfaces as VTK quad grids (points at z = -(recession + wear), m); a line
+    contact solved on one cross-section is drawn as a strip of the window's side along y
+    (its section at both edges)."""
     import meshio
 
     g = hist.grid
     paths = []
+    y = g.y if g.ny > 1 else np.array([-0.5 * g.dy, 0.5 * g.dy])
     for body, x, w, base in (("upper", g.x_upper, hist.wear_upper, hist.base_upper),
                              ("lower", g.x_lower, hist.wear_lower, hist.base_lower)):
+        if g.ny == 1:
+            w = np.repeat(w, 2, axis=1)
         nx, ny = w.shape
-        xx, yy = np.meshgrid(x, g.y, indexing="ij")
+        xx, yy = np.meshgrid(x, y, indexing="ij")
         # base recession is only stored at the central section: use the worn depth map
         # for z and give the unworn central profile as point data along x
         z = -w

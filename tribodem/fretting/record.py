@@ -4,27 +4,25 @@ debris-study``."""
 
 from __future__ import annotations
 
+import tomllib
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
+from tribodem.fretting.config import RESUME_MAY_CHANGE, recorded_config, resume_diffs
+from tribodem.io.config import ConfigError, dump_toml, load_toml
 
-def load_toml_roundtrip(data: dict[str, Any]) -> dict[str, Any]:
+
+def load_toml_roundtrip(data: Mapping[str, Any]) -> dict[str, Any]:
     """``data`` as it reads back from TOML (for comparing with a saved study)."""
-    import tomllib
-
-    from tribodem.io.config import dump_toml
-
-    return tomllib.loads(dump_toml(data))
+    return tomllib.loads(dump_toml(dict(data)))
 
 
 def read_study(out: Path) -> dict[str, Any]:
     """``out/study.toml`` of an earlier study (``fretting study``, ``debris-study``) as
     :func:`load_toml_roundtrip` gives it, its config read as
-    :func:`~tribodem.fretting.cli.recorded_config` reads a recorded one (``ConfigError``
-    naming ``--out`` when it cannot be read)."""
-    from tribodem.fretting.cli import recorded_config
-    from tribodem.io.config import ConfigError, load_toml
-
+    :func:`~tribodem.fretting.config.recorded_config` reads a recorded one
+    (``ConfigError`` naming ``--out`` when it cannot be read)."""
     path = Path(out) / "study.toml"
     data = load_toml(path, "--out")
     if not isinstance(data.get("config"), dict):
@@ -34,16 +32,14 @@ def read_study(out: Path) -> dict[str, Any]:
     return load_toml_roundtrip(data)
 
 
-def study_diffs(out: Path, meta: dict[str, Any],
+def study_diffs(out: Path, meta: Mapping[str, Any],
                 may_change: tuple[str, ...] | None = None) -> list[str]:
     """What keeps the study ``meta`` (its ``config`` and the rest: ``quick``, ``counts``)
     from resuming the one ``out/study.toml`` records (:func:`read_study`), each as "field =
     new (study: old)": the configs compared as a run's resume compares them
-    (:func:`~tribodem.fretting.cli.resume_diffs`: how ccx runs, ``[output]`` and ``cycles``
-    may change, or the fields of ``may_change``), the rest by equality. Empty when it may
-    resume."""
-    from tribodem.fretting.cli import RESUME_MAY_CHANGE, resume_diffs
-
+    (:func:`~tribodem.fretting.config.resume_diffs`: how ccx runs, ``[output]`` and
+    ``cycles`` may change, or the fields of ``may_change``), the rest by equality. Empty
+    when it may resume."""
     old = read_study(out)
     new = load_toml_roundtrip(meta)
     diffs = resume_diffs(old["config"], new.get("config") or {}, what="study",

@@ -7,7 +7,7 @@ and what is allowed (``ConfigError``; the CLI turns it into exit code 2, no trac
 from __future__ import annotations
 
 import tomllib
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any, TypeVar
 
@@ -90,28 +90,22 @@ def merge(base: dict[str, Any], override: dict[str, Any]) -> dict[str, Any]:
     return out
 
 
-def dump_toml(data: dict[str, Any]) -> str:
-    """Minimal TOML writer for resolved configs (tables of scalars/lists).
+def _without_none(value: Any) -> Any:
+    """``value`` with every None entry of its tables left out (TOML has no null), tables in
+    arrays too; tuples become lists."""
+    if isinstance(value, Mapping):
+        return {str(k): _without_none(v) for k, v in value.items() if v is not None}
+    if isinstance(value, list | tuple):
+        return [_without_none(v) for v in value]
+    return value
+
+
+def dump_toml(data: Mapping[str, Any]) -> str:
+    """The TOML text of a resolved config (tomli-w: tables of scalars, arrays, tables).
 
     A key whose value is None is left out (TOML has no null): on reload the field takes its
     default, which is None wherever a config model allows None, so the file round-trips.
     """
-    def fmt(v: Any) -> str:
-        if isinstance(v, bool):
-            return "true" if v else "false"
-        if isinstance(v, str):
-            return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
-        if isinstance(v, (list, tuple)):
-            return "[" + ", ".join(fmt(x) for x in v) + "]"
-        return repr(v)
+    import tomli_w
 
-    def table(prefix: str, d: dict[str, Any]) -> list[str]:
-        lines = [f"{k} = {fmt(v)}" for k, v in d.items()
-                 if v is not None and not isinstance(v, dict)]
-        for k, v in d.items():
-            if isinstance(v, dict):
-                name = f"{prefix}.{k}" if prefix else k
-                lines += [f"\n[{name}]", *table(name, v)]
-        return lines
-
-    return "\n".join(table("", data)) + "\n"
+    return tomli_w.dumps(_without_none(data))

@@ -36,8 +36,9 @@ import time
 import uuid
 from collections.abc import Callable, Hashable, Iterator, Sequence
 from contextlib import contextmanager
+from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Protocol
+from typing import Any
 
 from tribodem.io.config import ConfigError
 
@@ -48,33 +49,31 @@ WORKER_ENV = {"NUMBA_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS
 STOP_POLL_S = 2.0
 
 
-class Member(Protocol):
-    """What :func:`run_members` needs of a member.
+@dataclass
+class Member:
+    """One member of a sweep: an independent, idempotent task writing its own folder.
 
-    ``key``: the caller's key of its result and failure; ``label``: how messages name it;
-    ``folder``: where its task writes (``summary.json`` there when it finished);
-    ``task_name``: a short prefix of its Dask key (no spaces); ``task`` and ``args``: the
-    task, a picklable module-level function called on a worker as
-    ``task(*args, stop_event_name)``, returning the member's summary (a dict).
+    ``key``: the caller's key of its result and failure (a row's name, a (condition,
+    packing) pair); ``label``: how messages name it; ``task_name``: a short prefix of its
+    Dask key (no spaces); ``task``: a picklable module-level function called on a worker
+    as ``task(data, str(folder), stop_event_name)``, returning the member's summary (a
+    dict); ``data``: the member's config (a dict shaped like the TOML); ``folder``: where
+    the task writes (``summary.json`` there when it finished); ``info``: what the room
+    keeps beside it (a table row's cells, the condition number).
     """
 
-    @property
-    def key(self) -> Hashable: ...
+    key: Hashable
+    label: str
+    task_name: str
+    task: Callable[..., dict[str, Any]]
+    data: dict[str, Any]
+    folder: Path
+    info: dict[str, Any] = field(default_factory=dict)
 
     @property
-    def label(self) -> str: ...
-
-    @property
-    def folder(self) -> Path: ...
-
-    @property
-    def task_name(self) -> str: ...
-
-    @property
-    def task(self) -> Callable[..., dict[str, Any]]: ...
-
-    @property
-    def args(self) -> tuple[Any, ...]: ...
+    def args(self) -> tuple[Any, ...]:
+        """The task's arguments before the stop event's name: the config and the folder."""
+        return self.data, str(self.folder.resolve())
 
 
 def stop_check(event_name: str | None) -> Callable[[], bool] | None:

@@ -5,8 +5,9 @@ One vocabulary for every command (``tribodem.cli.main`` maps it to exit codes):
 - :class:`~tribodem.io.config.ConfigError` -> exit 2 (bad input, refused before any work);
 - :class:`RunStopped` -> exit 3 (an early stop or a numerical instability; outputs kept);
 - ``KeyboardInterrupt`` (Ctrl-C, SIGINT) -> exit 130, after saying where the outputs and the
-  last checkpoint are. A command announces its outputs with :func:`announce` as soon as it
-  has checked them, and its checkpoint with :func:`checkpoint_written`.
+  last checkpoint are (:func:`interrupted_message`). A command announces its outputs with
+  :func:`announce` as soon as it has checked them, and its checkpoint with
+  :func:`checkpoint_written`.
 
 :func:`check_out_dir` checks an output location before any work; :func:`progress` is the one
 progress bar (tqdm on stderr, with an ETA; off when ``enabled`` is false).
@@ -14,13 +15,14 @@ progress bar (tqdm on stderr, with an ETA; off when ``enabled`` is false).
 
 from __future__ import annotations
 
+import functools
 import os
 import tempfile
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
 
 from tribodem.io.config import ConfigError
 
@@ -42,15 +44,88 @@ class _Current:
 _current = _Current()
 
 
+#: the lock file in a run folder while a run writes there
+LOCK_NAME = ".tribodem.lock"
+#: run folders this process holds locked: resolved path -> open lock file descriptor
+_locks: dict[Path, int] = {}
+
+
 def announce(out: str | Path, checkpoint: str | Path | None = None,
-             resume_hint: str | None = None) -> None:
-    """Say which folder this command writes (and where its checkpoint will be).
+             resume_hint: str | None = None, lock: bool = True) -> None:
+    """Say which folder this command writes (and where its checkpoint will be), once every
+    input has been checked, and take the folder's lock (:func:`lock_folder`: ``ConfigError``
+    naming the process that holds it).
 
     ``resume_hint``: how to continue (e.g. "add --resume to the same command").
     """
+    if lock:
+        lock_folder(out)
     _current.out = Path(out)
     _current.checkpoint = Path(checkpoint) if checkpoint is not None else None
     _current.resume_hint = resume_hint
+
+
+def started() -> bool:
+    """Whether this command has announced its outputs (its checks passed, its work began)."""
+    return _current.out is not None
+
+
+def lock_folder(out: str | Path, field: str = "--out") -> None:
+    """Hold ``out`` (made if missing) for this process: an exclusive ``flock`` on
+    ``out/.tribodem.lock``, which holds the holder's pid. A second run or resume on the
+    folder, from another process, is refused (``ConfigError`` naming the pid); the kernel
+    drops the lock when its process ends, so a lock left by a killed run is free again.
+    Taking a folder this process holds already does nothing."""
+    import fcntl
+
+    p = Path(out)
+    key = p.resolve()
+    if key in _locks:
+        return
+    p.mkdir(parents=True, exist_ok=True)
+    fd = os.open(p / LOCK_NAME, os.O_RDWR | os.O_CREAT, 0o644)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        holder = os.read(fd, 64).decode(errors="replace").strip() or "unknown"
+        os.close(fd)
+        raise ConfigError(f"{field} = '{p}': the folder is in use by another tribodem run "
+                          f"(pid {holder}); allowed: another folder, or the same one once "
+                          "that run has ended") from None
+    os.ftruncate(fd, 0)
+    os.write(fd, f"{os.getpid()}\n".encode())
+    _locks[key] = fd
+
+
+def release_folders(keep: frozenset[Path] = frozenset()) -> None:
+    """Give up the run folders this process holds, but those in ``keep`` (the end of a run
+    called from Python, or of a sweep member's task on a worker that lives on)."""
+    for key, fd in list(_locks.items()):
+        if key in keep:
+            continue
+        try:
+            os.close(fd)
+        finally:
+            del _locks[key]
+
+
+F = TypeVar("F", bound=Callable[..., Any])
+
+
+def releases_folders(fn: F) -> F:
+    """Decorate a public run function: the folders it locked (:func:`announce`) are given
+    up when it returns or raises, so a notebook can run in a folder again, or another
+    process resume there; folders locked before the call stay locked."""
+
+    @functools.wraps(fn)
+    def wrapper(*args: Any, **kwargs: Any) -> Any:
+        before = frozenset(_locks)
+        try:
+            return fn(*args, **kwargs)
+        finally:
+            release_folders(keep=before)
+
+    return wrapper  # type: ignore[return-value]
 
 
 def checkpoint_written(path: str | Path) -> None:
@@ -63,7 +138,8 @@ def where() -> str:
     c = _current
     if c.out is None:
         return ""
-    if not c.out.exists():  # stopped before its first file (e.g. calibrate writes at the end)
+    if not c.out.exists() or not any(  # stopped before its first file (calibrate writes at
+            f.name != LOCK_NAME for f in c.out.iterdir()):  # the end)
         return f"no outputs were written yet (they go to '{c.out}')"
     text = f"outputs so far are in '{c.out}'"
     if c.checkpoint is not None and c.checkpoint.exists():
@@ -73,6 +149,15 @@ def where() -> str:
     elif c.checkpoint is not None:
         text += "; no checkpoint was written yet"
     return text
+
+
+def interrupted_message() -> str:
+    """The Ctrl-C (or SIGTERM) message: where the outputs and the last checkpoint are
+    (:func:`where`)."""
+    from tribodem.io import signals
+
+    text = where()
+    return "\n" + signals.words() + (f": {text}" if text else "")
 
 
 def check_out_dir(out: str | Path, field: str = "--out", resume: bool = False,
@@ -85,6 +170,9 @@ def check_out_dir(out: str | Path, field: str = "--out", resume: bool = False,
     removed.
     """
     p = Path(out)
+    if not str(out).strip():
+        raise ConfigError(f"{field} = {str(out)!r}: allowed: a folder path (not empty)")
+    check_path_length(p, field)
     if p.exists() and not p.is_dir():
         raise ConfigError(f"{field} = '{p}': is a file, not a folder; allowed: a folder "
                           "(existing or new)")
@@ -117,6 +205,27 @@ def check_out_dir(out: str | Path, field: str = "--out", resume: bool = False,
             raise ConfigError(f"{field} = '{p}': cannot write there ({err.strerror})"
                               ) from None
     return p
+
+
+def check_path_length(p: Path, field: str) -> None:
+    """Refuse (``ConfigError``) a path the file system cannot hold: a name over its
+    ``NAME_MAX`` bytes or a whole path over ``PATH_MAX`` (255 and 4,096 on Linux)."""
+    absolute = os.path.abspath(p)
+    name_max, path_max = 255, 4096
+    try:
+        probe = next(q for q in (p, *p.parents) if q.exists())
+        name_max = os.pathconf(probe, "PC_NAME_MAX")
+        path_max = os.pathconf(probe, "PC_PATH_MAX")
+    except (StopIteration, OSError, ValueError):
+        pass
+    long = next((part for part in p.parts if len(os.fsencode(part)) > name_max), None)
+    if long is not None:
+        raise ConfigError(f"{field} = '{p}': the name '{long[:40]}...' has "
+                          f"{len(os.fsencode(long))} bytes; allowed: names of at most "
+                          f"{name_max} bytes")
+    if len(os.fsencode(absolute)) >= path_max:
+        raise ConfigError(f"{field} = '{str(p)[:60]}...': the path has "
+                          f"{len(os.fsencode(absolute))} bytes; allowed: less than {path_max}")
 
 
 def check_out_file(path: str | Path, field: str) -> Path:

@@ -2,8 +2,10 @@
 
 ``en24t`` (seed 003's first-body steel: tables 5.1, 6.2, section 5.2), ``library`` (seed 000
 tables 1 and 3: ``MaterialSpec``, ``Q345B``, ``CU_PM``), ``specimen`` (bonded specimen
-generation), ``compression`` (uniaxial compression test, eq 12), ``calibrate`` (automatic
-E_c / kratio calibration), ``cli`` (``tribodem calibrate``).
+generation), ``compression`` (uniaxial compression test, eq 12), ``calibration`` (automatic
+E_c / kratio calibration: :func:`calibrate_spec` on a spec, :func:`calibrate` the run of
+``tribodem calibrate`` from Python, returning a :class:`~tribodem.io.record.RunResult`),
+``cli`` (``tribodem calibrate``).
 
 Names are imported on first use (PEP 562), so reading a material constant does not load the
 particle engine.
@@ -16,7 +18,8 @@ from typing import Any
 
 _WHERE = {
     "EN24T": "en24t", "SolidMaterial": "en24t",
-    "CalibrationResult": "calibrate", "calibrate": "calibrate",
+    "CalibrationResult": "calibration", "calibrate": "calibration",
+    "calibrate_spec": "calibration",
     "CompressionResult": "compression", "fit_moduli": "compression",
     "run_compression": "compression",
     "CU_PM": "library", "LIBRARY": "library", "Q345B": "library", "MaterialSpec": "library",

@@ -1,4 +1,4 @@
-"""Issue 15, session 30: condition-5 runs with the debris outlet and the feed.
+"""Condition-5 runs with the debris outlet and the feed.
 
     python docs/data/braking_feed/analyse.py RUN_DIR [RUN_DIR ...]
 

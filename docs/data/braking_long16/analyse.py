@@ -1,8 +1,8 @@
-"""Issue 15: the default cell with a 3x thicker pad slid up to 16 mm (condition 5).
+"""The default cell with a 3x thicker pad slid up to 16 mm (condition 5).
 
     python docs/data/braking_long16/analyse.py RUN_DIR [RUN_DIR ...]
 
-Per run (``tribodem braking run --condition 5 --config long_K.toml``, one folder each):
+Per run (``tribodem braking run --condition 5 --config fixed.toml``, one folder each):
 the summary's steady-state reading, then the pad's wear rate per sliding distance in
 consecutive windows of ``WINDOW`` (least-squares slope of the mean pad wear depth against
 the distance slid, ``timeseries.csv``), so one sees whether the rate still falls after the
@@ -18,9 +18,9 @@ from pathlib import Path
 
 import numpy as np
 
-from tribodem.braking.cli import RunCfg
 from tribodem.braking.compare import _series  # the sweep comparison's timeseries reader
-from tribodem.braking.run import STEADY_BLOCK, STEADY_CUTS, _slope, steady_state
+from tribodem.braking.config import RunCfg
+from tribodem.braking.steady import STEADY_BLOCK, STEADY_CUTS, _slope, steady_state
 
 WINDOW = 2.0e-3  # m of sliding per window
 #: ``until_steady`` as the default run does it: first test after 40 us, then every 8 us
@@ -30,7 +30,7 @@ BLOCK_S = STEADY_BLOCK * FIRST_S
 
 def first_pass(ts: dict[str, np.ndarray], cuts: tuple[float, ...],
                tol: float = 0.15) -> tuple[float, float]:
-    """Where the tool's own rule (``tribodem.braking.run.steady_state`` with ``cuts``)
+    """Where the tool's own rule (``tribodem.braking.steady.steady_state`` with ``cuts``)
     first passes on the run's prefix, tested as ``until_steady`` tests it; (distance m,
     the steady rate it would report m/m), or NaNs if it never passes."""
     t, s, h = ts["time_s"], ts["sliding_distance_m"], ts["wear_depth_mean_pad_m"]

@@ -1,4 +1,4 @@
-"""Issue 15: the steady wear rate with the debris outlet, its scatter, seed 000's trends.
+"""The steady wear rate with the debris outlet, its scatter, seed 000's trends.
 
     python docs/data/braking_outlet/analyse.py PATTERN [--conditions 5,1,3] [--from 4e-3]
 
@@ -7,14 +7,14 @@
 with the 324-um pad and ``[run] outlet_length_m`` (``c5.toml``), 12 mm of sliding. Per
 run: the steady wear rate of its summary (slope of the pad's mean wear depth over the last
 two thirds of the distance), the rate from ``--from`` (default 2 mm) to the end, the
-steady-state rule (``tribodem.braking.run.steady_state`` with ``STEADY_CUTS``) tested as
+steady-state rule (``tribodem.braking.steady.steady_state`` with ``STEADY_CUTS``) tested as
 ``[run] until_steady`` tests it -- first at the default 40 us of condition 5 (1.9 mm),
 then every 20 % of that -- the distance where it first passes, and the contact fraction.
 Per condition: mean and sd/mean of the rates over the packings. Then the paired changes of
 the rate 13 -> 21 kN (condition 1 -> 5) and 800 -> 1200 r/min (3 -> 5) with their 95 %
 intervals (``tribodem.braking.compare``) beside the seed's. Markdown on stdout. Runs made
-since session 29 also show the disc's wear rate and the intact thickness of each body left
-at the end (``remaining_thickness_*``; nan for older runs).
+with the thick bodies (``thick.toml``) also show the disc's wear rate and the intact
+thickness of each body left at the end (``remaining_thickness_*``; nan for older runs).
 """
 
 from __future__ import annotations
@@ -26,7 +26,6 @@ from pathlib import Path
 import numpy as np
 from scipy.stats import chi2
 
-from tribodem.braking.cli import RunCfg
 from tribodem.braking.compare import (
     SEED_CHANGES,
     _series,
@@ -36,7 +35,8 @@ from tribodem.braking.compare import (
     seed_inside,
 )
 from tribodem.braking.conditions import get_condition
-from tribodem.braking.run import STEADY_BLOCK, STEADY_CUTS, _slope, steady_state
+from tribodem.braking.config import RunCfg
+from tribodem.braking.steady import STEADY_BLOCK, STEADY_CUTS, _slope, steady_state
 
 V5 = get_condition(5).speed_m_s
 FIRST = RunCfg().duration_s * V5  # m: where until_steady first tests (40 us at 1200 r/min)

@@ -1,5 +1,5 @@
 """How the run-to-run scatter of a wear rate falls with the sliding window it is measured
-over (docs/braking.md, issue 15): for every finished member of one condition of a braking
+over (docs/braking.md): for every finished member of one condition of a braking
 sweep, the pad's mean wear depth is read from timeseries.csv; after the run-in (the first
 third of the distance) the rest is cut into windows of length L, and the rate of each
 window, (depth at the end - depth at the start) / L, is pooled over the members. If the

@@ -1,4 +1,4 @@
-"""Issue 15: seed 000's two trends asked of the saturated wear depth, not of the run-in.
+"""Seed 000's two trends asked of the saturated wear depth, not of the run-in.
 
     python docs/data/braking_trends12/analyse.py C5_DIR_PATTERN C1_DIR_PATTERN C3_DIR_PATTERN
         [--skip K,K,...]
@@ -25,7 +25,6 @@ from pathlib import Path
 
 import numpy as np
 
-from tribodem.braking.cli import RunCfg
 from tribodem.braking.compare import (
     SEED_CHANGES,
     _series,
@@ -34,7 +33,8 @@ from tribodem.braking.compare import (
     seed_inside,
 )
 from tribodem.braking.conditions import get_condition
-from tribodem.braking.run import _slope
+from tribodem.braking.config import RunCfg
+from tribodem.braking.steady import _slope
 
 AT = 12.0e-3  # m slid: where the depth is compared
 V5 = get_condition(5).speed_m_s  # m/s: condition 5 (1200 r/min)

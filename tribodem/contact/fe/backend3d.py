@@ -26,7 +26,7 @@ a continuous test has there; for elastic bodies that is the steady Mindlin-Deres
 primed by that half cycle only (not accumulated over the run).
 
 Worn geometry (seed eqs 3.7-3.8): the worn depth of each body at each node column (i, j) is
-its recession (from :meth:`set_surfaces`) minus the unworn one (the constructor's), at the
+its recession (from :meth:`set_surfaces`) minus the unworn one (the case's), at the
 column's (x, y) (upper: its own frame, over the window; lower: lab frame, over the window plus
 the stroke); the surface node moves into its body by that depth and the fine-section nodes
 below it are redistributed proportionally (x, y unchanged, :func:`morph_columns3d`);
@@ -52,64 +52,60 @@ import io
 import math
 import time
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
 
 from tribodem.contact.base import (
     BODIES,
-    Body,
     Capabilities,
-    ElasticBody,
-    FirstBodySolver,
     IncrementResult,
     Recession,
-    SubsurfaceStress,
     WindowTooSmallError,
-    _check_positive,
     checked_debris_pressure,
-    contact_modulus,
-    cycle_offsets,
     mindlin_kappa,
 )
 from tribodem.contact.elastoplastic import PlasticStep
-from tribodem.contact.fe.backend import (
-    PLASTIC_LOAD_INCREMENTS,
-    PLASTIC_MIN_INCREMENTS,
-    cell_average,
+from tribodem.contact.fe.backend import PLASTIC_LOAD_INCREMENTS, cell_average
+from tribodem.contact.fe.base import (
+    CcxBackend,
+    column_set,
+    nodal_mean,
+    residual_surfaces,
+    traction_quarters,
 )
-from tribodem.contact.fe.ccx import (
-    CcxConvergenceError,
-    FESolverStopped,
-    ccx_build,
-    find_ccx,
-)
+from tribodem.contact.fe.ccx import CcxConvergenceError, FESolverStopped
 from tribodem.contact.fe.crossed import (
     GAUSS_2X2X2,
     NODE_XI,
     CrossedCase,
     Mesh3D,
-    _dshape,
     crossed_mesh,
+    dshape,
     element_forces,
     tributary_area,
+    write_mesh3d,
+    write_ref_tie,
 )
 from tribodem.contact.fe.deck import (
     ContactSettings,
-    _fmt,
-    _static,
-    _time_points,
-    _write_ids,
-    sliding_contact,
+    FEMaterial,
+    fmt,
+    static_step,
+    write_material,
+    write_time_points,
 )
-from tribodem.contact.fe.jobs import CcxJobs, JobRecord, check_stress_depth, checked_increments
-from tribodem.contact.fe.mesh import surface_projection, worn_depth
+from tribodem.contact.fe.jobs import checked_increments
+from tribodem.contact.fe.options import CONVERGED_SLOPE as CONVERGED_SLOPE
+from tribodem.contact.fe.options import FEOptions
 from tribodem.contact.fe.results import DatBlock, read_dat
 from tribodem.contact.fe.slope import SlopeLimit, limit_slope, steepest
-from tribodem.contact.geometry import HertzSphere, crossed_cylinders
-from tribodem.contact.halfspace import max_shear, von_mises
-from tribodem.materials.en24t import EN24T
+from tribodem.contact.geometry import HertzSphere
+
+if TYPE_CHECKING:
+    from tribodem.contact.base import ContactCase
+    from tribodem.contact.options import PlasticOptions
 
 #: default element size at the contact / Hertz radius of the 3D backend (a/3: Hertz p0 and
 #: a within 3 % on the window, gross slip within 0.5 %, 4-8 min per +-25 um cycle on the
@@ -128,11 +124,6 @@ PENALTY_FACTOR = 10.0
 #: many cutbacks"); from 1/4 of it, 1-3; the elastic quick case (+-0.3 mm, 48 increments)
 #: stopped at its first reversal after 6 (docs/fe3d.md, measured)
 REVERSAL_SLIDE = 0.25
-#: the steepest worn-depth step / column spacing on which the seed's elastic-plastic shear
-#: run converged (docs/fe3d.md "Worn geometry": cycle 2 on 0.093 / 0.099 converged, cycle 3
-#: on 0.22 / 0.24 did not, h = a/3); a job that fails on steeper surfaces says so
-CONVERGED_SLOPE = 0.1
-
 #: modes of :class:`FE3DContactSolver` (``chained`` is the 2D backend's only)
 MODES = ("fresh", "primed")
 
@@ -140,8 +131,6 @@ MODES = ("fresh", "primed")
 #: its inverse extrapolates Gauss-point values to the nodes
 _N_AT_GP = np.prod(1.0 + GAUSS_2X2X2[:, None, :] * NODE_XI[None, :, :], axis=2) / 8.0
 _EXTRAPOLATE3 = np.linalg.inv(_N_AT_GP)
-#: the Gauss point nearest each C3D8 node (the one in the node's octant), [8 nodes]
-_NEAREST_GAUSS3 = np.argmax(NODE_XI @ GAUSS_2X2X2.T, axis=1)
 
 
 #: mirror signs (y -> -y) of the stress components (ccx order xx, yy, zz, xy, xz, yz) and
@@ -184,7 +173,7 @@ def hex_volumes(nodes: NDArray[np.float64], elements: NDArray[np.int64]) -> NDAr
     x = nodes[elements]
     vol = np.zeros(elements.shape[0])
     for xi in GAUSS_2X2X2:
-        vol += np.linalg.det(np.einsum("mki,kj->mij", x, _dshape(xi)))
+        vol += np.linalg.det(np.einsum("mki,kj->mij", x, dshape(xi)))
     return vol
 
 
@@ -267,48 +256,56 @@ def _operator(xn: NDArray[np.float64], centres: NDArray[np.float64], dx: float,
     return np.stack([np.interp(centres, xn, e, left=0.0, right=0.0) for e in eye], axis=1)
 
 
-class FE3DContactSolver(CcxJobs, FirstBodySolver):
+class FE3DContactSolver(CcxBackend[Mesh3D]):
     """3D CalculiX crossed-cylinder first body, half model (see the module docstring).
 
-    ``upper``/``lower``: recessions (m) of a cylinder with its axis along y and one with its
-    axis along x, of equal radius R (read from their curvatures at the origin; default the
-    seed's R = 4 mm). ``load``: normal load, N; ``friction``: Coulomb mu; ``n``, ``window``
-    (m; None: ``window_radii`` Hertz radii); ``amplitude`` (m) and ``n_increments`` of the
-    loop's cycle (the job's output times); ``h_over_a`` (element size at the contact / Hertz
-    radius a), ``size_factor`` (bodies' extent / a, at most R / (2 a)) and ``growth`` of the
-    mesh; ``stress_depth`` (m): how deep the column stresses are printed (None: 4.5 a, 1.5 x
-    the threshold criteria's default grid depth 3 a); ``threads``, ``timeout`` (s per ccx
-    job), ``retries`` (after a non-convergence: :func:`.jobs.attempt_settings`, halved
-    increments, then a softer contact); ``loading_friction``: the friction while seating
-    and loading (:data:`.jobs.LOADING_FRICTION`: ``"auto"``, mu for elastic-plastic
-    bodies and 0.001 for elastic ones); ``max_wear_slope``: the steepest worn-depth step /
-    column spacing the morphed mesh carries (:func:`.slope.limit_slope`, volume kept; default
-    :data:`CONVERGED_SLOPE`; None: the criterion's surface as projected);
-    ``cycle_increments``: the fewest ccx increments per cycle, the output times staying
-    the loop's ``n_increments`` (None: ``n_increments``, and ``plastic_increments`` for
-    elastic-plastic bodies; the quick preset's 64 took 443 -> 299 Newton iterations a cycle,
-    docs/fe3d.md "Contact set-up", quick preset);
-    ``workdir``: the jobs' folder (``cycle_0001/`` ...; None: a new temporary folder).
-    ``regime`` and ``tolerance`` are the half-space's options and are not used, nor is
-    ``chain_cycles`` (mode ``chained`` of the 2D backend); ``material`` is ``"elastic"`` or
-    ``"elastic-plastic"`` (bilinear EN24T by default, fresh cycles; ``beyond_uts``: past the
-    UTS the hardening line goes on, ``"line"``, or the flow stress is held, ``"hold"``).
+    ``case`` (:class:`~tribodem.contact.base.ContactCase`): ``upper``/``lower`` are the
+    recessions (m) of a cylinder with its axis along y and one with its axis along x, of
+    equal radius R (read from their curvatures at the origin; the seed's R = 4 mm);
+    ``load``: normal load, N; ``window`` None: ``window_radii`` Hertz radii;
+    ``stress_depth`` None: 4.5 a, 1.5 x the threshold criteria's default grid depth 3 a. The
+    rest as :class:`~tribodem.contact.fe.base.CcxBackend`; ``growth``: the mesh's element
+    growth outside the fine zone.
+
+    ``fe`` (:class:`~tribodem.contact.fe.options.FEOptions`, every field; ``chain_cycles``
+    is taken and not used, mode ``chained`` being the 2D backend's): ``h_over_a`` (element
+    size at the contact / Hertz radius a; own 1/3), ``size_factor`` (bodies' extent / a, at
+    most R / (2 a); own 8); ``threads``, ``timeout`` (s per ccx job; own 14400 s),
+    ``retries`` (after a non-convergence: :func:`.jobs.attempt_settings`, halved
+    increments, then a softer contact), ``retry_from``, ``loading_friction`` (the friction
+    while seating and loading, :data:`.jobs.LOADING_FRICTION`: ``"auto"``, mu for
+    elastic-plastic bodies and 0.001 for elastic ones), ``cache``; ``max_wear_slope``: the
+    steepest worn-depth step / column spacing the morphed mesh carries
+    (:func:`.slope.limit_slope`, volume kept; default :data:`CONVERGED_SLOPE`; None: the
+    criterion's surface as projected); ``cycle_increments``: the fewest ccx increments per
+    cycle, the output times staying the loop's ``n_increments`` (None: ``n_increments``,
+    and ``plastic_increments`` for elastic-plastic bodies; the quick preset's 64 took 443
+    -> 299 Newton iterations a cycle, docs/fe3d.md "Contact set-up", quick preset);
+    ``mode`` ``"fresh"`` or ``"primed"``; ``material`` ``"elastic"`` or
+    ``"elastic-plastic"`` (the ``plastic`` table's law, bilinear EN24T by default, fresh
+    cycles; ``beyond_uts``: past the UTS the hardening line goes on, ``"line"``, or the
+    flow stress is held, ``"hold"``).
     """
 
     name = "fe3d"
+    contact = "point"
     #: the class's widest capabilities; an instance's are :meth:`capabilities_for` its
-    #: ``material`` (fresh mode only: plastic strain of one cycle at a time)
+    #: ``material`` (fresh mode only: plastic strain of one cycle at a time; never
+    #: ``plastic_every_cycle``: the 2D backend's ``chained`` mode is not built in 3D)
     capabilities = Capabilities(plastic=True, partial_slip=True, subsurface=True, debris=True,
                                 contacts=("point",))
-
-    @classmethod
-    def capabilities_for(cls, options: dict[str, Any]) -> Capabilities:
-        """Plastic strain with ``material = "elastic-plastic"``; never ``plastic_every_cycle``
-        (a fresh job starts every cycle from virgin bodies: the 2D backend's ``chained`` mode
-        is not built in 3D)."""
-        plastic = options.get("material", "elastic") == "elastic-plastic"
-        return Capabilities(plastic=plastic, partial_slip=True, subsurface=True, debris=True,
-                            contacts=("point",))
+    FE_FIELDS = frozenset(FEOptions.model_fields)
+    OWN_DEFAULTS = {"h_over_a": FRETTING3D_H_OVER_A, "size_factor": FRETTING3D_SIZE_FACTOR,
+                    "timeout": 14400.0}
+    MODES = MODES
+    SOLVES = "crossed cylinders (a point contact)"
+    #: penalty 10 E / h (50 E / h, the 2D value, made the reversals' stick/slip states
+    #: flip for ever at h = a/2: measured, docs/fe3d.md)
+    PENALTY_FACTOR = PENALTY_FACTOR
+    #: the Gauss point nearest each C3D8 node (the one in the node's octant), [8 nodes]
+    NEAREST_GAUSS = np.argmax(NODE_XI @ GAUSS_2X2X2.T, axis=1)
+    #: first yield of a point contact at 0.48 a, shallower with friction
+    PLASTIC_DEPTH_RADII = 1.5
 
     @classmethod
     def options_for(cls, names: set[str]) -> str:
@@ -318,79 +315,46 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
     #: along x instead, so no slave node sits on a master node
     small_sliding: bool = False
 
-    def __init__(
-        self,
-        upper: Recession | None = None,
-        lower: Recession | None = None,
-        load: float = 100.0,
-        friction: float = 0.6,
-        upper_material: ElasticBody | None = None,
-        lower_material: ElasticBody | None = None,
-        n: int = 64,
-        window: float | None = None,
-        window_radii: float = 10.0,
-        contact: str = "point",
-        amplitude: float = 25e-6,
-        n_increments: int = 8,
-        mode: str = "fresh",
-        material: str = "elastic",
-        chain_cycles: int = 5,
-        plastic_increments: int = PLASTIC_MIN_INCREMENTS,
-        cycle_increments: int | None = None,
-        yield_strength: float = EN24T.yield_strength,
-        uts: float = EN24T.uts,
-        uts_strain: float = EN24T.uts_strain,
-        hardening: float | None = None,
-        beyond_uts: str = "line",
-        h_over_a: float = FRETTING3D_H_OVER_A,
-        size_factor: float = FRETTING3D_SIZE_FACTOR,
-        growth: float = FRETTING3D_GROWTH,
-        threads: int = 1,
-        timeout: float = 14400.0,
-        retries: int = 1,
-        retry_from: str = "first",
-        loading_friction: str = "auto",
-        cache: str | Path | None = None,
-        max_wear_slope: float | None = CONVERGED_SLOPE,
-        workdir: str | Path | None = None,
-        executable: str | None = None,
-        stress_depth: float | None = None,
-        regime: str = "gross",
-        tolerance: float | None = None,
-        ep_n: int | None = None,
-        ep_nz: int | None = None,
-        ep_window_radii: float | None = None,
-        ep_depth_radii: float | None = None,
-        load_steps: int | None = None,
-        ep_tolerance: float | None = None,
-    ) -> None:
-        del regime, tolerance, chain_cycles  # not used (see the class docstring)
-        del ep_n, ep_nz, ep_window_radii, ep_depth_radii, load_steps, ep_tolerance
-        if (upper is None) != (lower is None):
-            raise ValueError("upper and lower must both be given or both be None (defaults)")
-        if upper is None or lower is None:
-            upper, lower = crossed_cylinders()
-        if contact != "point":
-            raise ValueError(f"contact = {contact!r} is not allowed: the fe3d backend solves "
-                             "crossed cylinders (a point contact); allowed: 'point'")
-        if mode not in MODES:
-            raise ValueError(f"mode = {mode!r} is not allowed for the fe3d backend: allowed: "
-                             f"{', '.join(MODES)}")
-        self._set_material(material, plastic_increments, yield_strength, uts, uts_strain,
-                           hardening, beyond_uts)
-        self.capabilities = self.capabilities_for({"material": material})
-        self.mode = mode
-        self.executable = find_ccx(executable)
-        self.upper, self.lower = upper, lower
-        self._base_upper, self._base_lower = upper, lower
-        self.friction = _check_positive("friction", friction, allow_zero=True)
-        self.upper_material = upper_material or ElasticBody()
-        self.lower_material = lower_material or ElasticBody()
-        self.modulus = contact_modulus(self.upper_material, self.lower_material)
-        if int(n) != n or n < 16 or n % 2:
-            raise ValueError(f"n = {n!r} is not allowed: must be an even integer >= 16")
-        self.n = int(n)
-        self.contact = "point"
+    def __init__(self, case: ContactCase, fe: FEOptions | None = None,
+                 plastic: PlasticOptions | None = None, *, executable: str | None = None,
+                 workdir: str | Path | None = None, window_radii: float = 10.0,
+                 growth: float = FRETTING3D_GROWTH) -> None:
+        self.growth = growth  # checked with the mesh's other options
+        super().__init__(case, fe, plastic, executable=executable, workdir=workdir,
+                         window_radii=window_radii)
+
+    # -- options and geometry -------------------------------------------------------------
+    def _set_mesh_options(self, fe: FEOptions) -> None:
+        """The fewest ccx increments per cycle, the mesh's size and its growth."""
+        #: ccx increments per output increment of the cycle: at least ``cycle_increments``
+        #: (any material) and, plastic, ``plastic_increments`` per cycle
+        self.cycle_increments = (None if fe.cycle_increments is None else
+                                 checked_increments("cycle_increments", fe.cycle_increments))
+        fewest = max(self.plastic_increments if self.plastic else 1,
+                     self.cycle_increments or 1)
+        self.cycle_refine = math.ceil(fewest / self.n_increments)
+        super()._set_mesh_options(fe)
+        growth = self.growth
+        self.growth = float(growth)
+        if not (math.isfinite(self.growth) and self.growth >= 1.0):
+            raise ValueError(f"growth = {growth!r} is not allowed: must be >= 1")
+
+    def _set_job_options(self, fe: FEOptions, workdir: str | Path | None) -> None:
+        """How the jobs run, and the worn surface's slope limit."""
+        super()._set_job_options(fe, workdir)
+        max_wear_slope = fe.max_wear_slope
+        if max_wear_slope is not None and not (math.isfinite(max_wear_slope)
+                                               and max_wear_slope > 0.0):
+            raise ValueError(f"max_wear_slope = {max_wear_slope!r} is not allowed: a number "
+                             "> 0 (the steepest step / column spacing the mesh carries) or "
+                             "None (off)")
+        #: the steepest worn-depth step / column spacing the morphed mesh carries (None: the
+        #: criterion's surface as projected; :func:`.slope.limit_slope`)
+        self.max_wear_slope = None if max_wear_slope is None else float(max_wear_slope)
+
+    def _radius_of(self, upper: Recession, lower: Recession) -> float:
+        """R = 2 / (the upper's curvature along x + the lower's along y): crossed cylinders
+        of equal radius (the upper curved along x only, the lower along y only)."""
         ux, uy = _curvatures(upper)
         lx, ly = _curvatures(lower)
         if not (ux > 0 and ly > 0) or abs(uy) > 1e-6 * ux or abs(lx) > 1e-6 * ly:
@@ -401,64 +365,27 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         if abs(ux / ly - 1.0) > 1e-3:
             raise ValueError(f"the fe3d backend models cylinders of equal radius; got R = "
                              f"{1 / ux:.4g} and {1 / ly:.4g} m")
-        self.radius = 2.0 / (ux + ly)
-        self.load = _check_positive("load", load)
-        hz = HertzSphere(self.radius, self.load, self.modulus)
-        a = hz.contact_radius
-        if window is None:
-            window = _check_positive("window_radii", window_radii) * a
-        self.dx = _check_positive("window", window) / self.n
-        self.amplitude = _check_positive("amplitude", amplitude)
-        self.offsets = cycle_offsets(self.amplitude, n_increments)
-        self.n_increments = int(n_increments)
-        #: ccx increments per output increment of the cycle: at least ``cycle_increments``
-        #: (any material) and, plastic, ``plastic_increments`` per cycle
-        self.cycle_increments = (None if cycle_increments is None else
-                                 checked_increments("cycle_increments", cycle_increments))
-        fewest = max(self.plastic_increments if self.plastic else 1,
-                     self.cycle_increments or 1)
-        self.cycle_refine = math.ceil(fewest / self.n_increments)
-        self.h_over_a = _check_positive("h_over_a", h_over_a)
-        self.size_factor = _check_positive("size_factor", size_factor)
-        if self.size_factor * a > 0.5 * self.radius:
+        return 2.0 / (ux + ly)
+
+    def _default_window(self, radii: float) -> float:
+        return radii * self.hertz[1]
+
+    def _check_size_factor(self, size_factor: float) -> None:
+        a = self.hertz[1]
+        if size_factor * a > 0.5 * self.radius:
             raise ValueError(f"size_factor = {size_factor!r} is not allowed: the bodies' extent "
-                             f"size_factor x a = {self.size_factor * a:.4g} m must not exceed "
+                             f"size_factor x a = {size_factor * a:.4g} m must not exceed "
                              f"R / 2 = {0.5 * self.radius:.4g} m (allowed: <= "
                              f"{0.5 * self.radius / a:.3g})")
-        self.growth = float(growth)
-        if not (math.isfinite(self.growth) and self.growth >= 1.0):
-            raise ValueError(f"growth = {growth!r} is not allowed: must be >= 1")
-        if int(threads) != threads or threads < 1:
-            raise ValueError(f"threads = {threads!r} is not allowed: an integer >= 1")
-        self.threads = int(threads)
-        self.timeout = _check_positive("timeout", timeout)
-        if int(retries) != retries or retries < 0:
-            raise ValueError(f"retries = {retries!r} is not allowed: an integer >= 0")
-        self.retries = int(retries)
-        self._set_retry_from(retry_from)
-        if max_wear_slope is not None and not (math.isfinite(max_wear_slope)
-                                               and max_wear_slope > 0.0):
-            raise ValueError(f"max_wear_slope = {max_wear_slope!r} is not allowed: a number "
-                             "> 0 (the steepest step / column spacing the mesh carries) or "
-                             "None (off)")
-        #: the steepest worn-depth step / column spacing the morphed mesh carries (None: the
-        #: criterion's surface as projected; :func:`.slope.limit_slope`)
-        self.max_wear_slope = None if max_wear_slope is None else float(max_wear_slope)
-        #: folder of finished ccx jobs keyed by deck (:func:`.jobs.run_job`; None: no cache)
-        self.cache: Path | None = None if cache is None else Path(cache)
-        self.workdir: Path | None = None if workdir is None else Path(workdir)
-        self.stress_depth = (_check_positive("stress_depth", stress_depth)
-                             if stress_depth is not None else 4.5 * a)
-        #: node-to-surface, pair declared once, n2s tension 1e-5 p0 (docs/fe.md "Reversals"),
-        #: penalty 10 E / h (50 E / h, the 2D value, made the reversals' stick/slip states
-        #: flip for ever at h = a/2: measured, docs/fe3d.md), stick slope 0.1 x the penalty
-        self.settings: ContactSettings = sliding_contact(self.friction, hz.peak_pressure,
-                                                         penalty_factor=PENALTY_FACTOR)
-        self._set_loading_friction(loading_friction)
-        self.jobs: list[JobRecord] = []  #: every ccx job run, in order
+
+    def _default_stress_depth(self) -> float:
+        return 4.5 * self.hertz[1]
+
+    def _setup(self) -> None:
         self._mesh0 = self._base_mesh()
         self._cols = mesh_columns(self._mesh0)
-        self._grids = {b: _grid(self._mesh0, b) for b in BODIES}
+        self._grids: dict[str, tuple[NDArray[np.float64], NDArray[np.float64]]] = {
+            b: _grid(self._mesh0, b) for b in BODIES}
         self._xs, self._ys = self._grids["upper"]
         self._xl = self._grids["lower"][0]
         self._ys_full = _mirror(self._ys, -1.0)
@@ -471,8 +398,8 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         self._avg_y = _operator(self._ys_full, c, self.dx, True)
         self._pt_x = _operator(self._xs, c, self.dx, False)
         self._pt_y = _operator(self._ys_full, c, self.dx, False)
-        self._areas = {b: tributary_area(*np.meshgrid(xs, ys), xs, ys)
-                       for b, (xs, ys) in self._grids.items()}
+        self._areas: dict[str, NDArray[np.float64]] = {
+            b: tributary_area(*np.meshgrid(xs, ys), xs, ys) for b, (xs, ys) in self._grids.items()}
         self._area = self._areas["upper"]
         # the upper surface nodes all of whose bottom-layer elements are in UCONT (the
         # tractions are recovered there; elsewhere the element sums are incomplete)
@@ -486,42 +413,26 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         self._complete = count[self._cols["upper"][..., 0]] == 0.0
         #: per body, what ``max_wear_slope`` did to the last :meth:`column_wear`
         self.slope_limits: dict[str, SlopeLimit] = {}
-        self.reset()
-        self._cycle = 0
-        self._job_key: tuple[bytes, ...] | None = None
-        self._served: list[IncrementResult] = []
         self._loaded_result: IncrementResult | None = None
-        self._fresh_for_cycle = False
-        self._time_of: dict[int, float] = {}
-        self._nodal_cache: dict[tuple[str, float], NDArray[np.float64]] = {}
-        self._peeq_cache: dict[tuple[str, str, float], NDArray[np.float64]] = {}
-        self._pending: list[PlasticStep] = []
-        self.cycle_reports: list[dict[str, Any]] = []  #: :meth:`_cycle_report` per job
         self._debris_pressure = np.zeros((self.n, self.n))  # prescribed debris pressure, Pa
         self._debris_load = 0.0
-        self.mesh: Mesh3D = self._mesh0  #: the (morphed) mesh of the last job
+        self.mesh = self._mesh0
 
-    # -- geometry -------------------------------------------------------------------------
     @property
     def hertz(self) -> tuple[float, float]:
         """Hertz (p0 Pa, a m) of the unworn contact (a sphere of radius R on a flat)."""
         hz = HertzSphere(self.radius, self.load, self.modulus)
         return hz.peak_pressure, hz.contact_radius
 
-    @property
-    def pad(self) -> float:
-        """Half-length the lower body's track extends beyond the window along x, m (the
-        loop's track grid: ceil(A / dx) + 1 cells)."""
-        return (math.ceil(self.amplitude / self.dx) + 1) * self.dx
-
     def _base_mesh(self) -> Mesh3D:
         """The unworn half mesh with the element sets ``UCOL``/``LCOL`` of the columns under
         the window (lower: plus the stroke) down to :attr:`stress_depth`."""
         a = self.hertz[1]
-        case = CrossedCase(load=self.load, radius=self.radius, h_fine=self.h_over_a * a,
+        h = self.h_over_a * a
+        case = CrossedCase(load=self.load, radius=self.radius, h_fine=h,
                            size_factor=self.size_factor, growth=self.growth,
                            delta=self.amplitude)
-        mesh = crossed_mesh(case, a=a, shift_lower=0.5 * case.h_fine)
+        mesh = crossed_mesh(case, a=a, shift_lower=0.5 * h)
         cols = mesh_columns(mesh)
         depth = np.full(mesh.nodes.shape[0], np.inf)
         for body in BODIES:
@@ -551,38 +462,25 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
             mesh.element_sets[name] = el[keep]
         return mesh
 
-    def column_wear(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """Worn depth (m, >= 0) of each node column (j, i) of the (upper, lower) mesh, [ny,
-        nx]: the lumped projection (:func:`surface_projection`, sampled at dx / 2) of the
-        current recession minus the unworn one (upper: its own frame, lower: lab frame,
-        clipped at zero) onto the surface nodes; zero outside the window (upper) and the
-        window plus the stroke (lower) along x, and beyond the window's last point along y,
-        where the loop gives no surface. The morphed mesh so loses the loop's worn volume.
-        With ``max_wear_slope`` the depths are then relaxed, volume for volume, until no
-        step between neighbouring columns is steeper (:func:`.slope.limit_slope`; what it
-        did per body in :attr:`slope_limits`)."""
-        c = self.coords
-        out = []
-        for body, now, base, lo, hi in (
-                ("upper", self.upper, self._base_upper, c[0], c[-1]),
-                ("lower", self.lower, self._base_lower, c[0] - self.pad, c[-1] + self.pad)):
-            w = surface_projection(worn_depth(now, base), *self._grids[body],
-                                   (lo, hi, -np.inf, c[-1]), 0.5 * self.dx)
-            if self.max_wear_slope is not None and w.any():
-                w, lim = limit_slope(w, *self._grids[body], self._areas[body],
-                                     self.max_wear_slope)
-                self.slope_limits[body] = lim
-            out.append(w)
-        return out[0], out[1]
+    def _projection_grid(self, body: str) -> tuple[NDArray[np.float64], NDArray[np.float64],
+                                                    float]:
+        """``body``'s column grid (x, y >= 0 of the half model), given up to the window's
+        last point along y."""
+        xs, ys = self._grids[body]
+        return xs, ys, float(self.coords[-1])
 
-    def morphed_mesh(self) -> Mesh3D:
-        """The unworn mesh with both surfaces receded by :meth:`column_wear` (eqs 3.7-3.8)."""
-        wu, wl = self.column_wear()
-        try:
-            m = morph_columns3d(self._mesh0, "upper", wu) if wu.any() else self._mesh0
-            return morph_columns3d(m, "lower", wl) if wl.any() else m
-        except ValueError as err:
-            raise FESolverStopped(f"mesh morphing: {err}") from None
+    def _relaxed(self, body: str, wear: NDArray[np.float64]) -> NDArray[np.float64]:
+        """With ``max_wear_slope`` the depths relaxed, volume for volume, until no step
+        between neighbouring columns is steeper (:func:`.slope.limit_slope`; what it did per
+        body in :attr:`slope_limits`)."""
+        if self.max_wear_slope is not None and wear.any():
+            wear, lim = limit_slope(wear, *self._grids[body], self._areas[body],
+                                    self.max_wear_slope)
+            self.slope_limits[body] = lim
+        return wear
+
+    def _morph(self, mesh: Mesh3D, body: str, wear: NDArray[np.float64]) -> Mesh3D:
+        return morph_columns3d(mesh, body, wear)
 
     def worn_volume(self, body: str, mesh: Mesh3D | None = None) -> float:
         """Worn volume of ``body`` (m^3, both halves): the exact volume between the unworn and
@@ -617,122 +515,105 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         kappa = mindlin_kappa(self.upper_material, self.lower_material)
         return self.friction * kappa * a * a / self.radius
 
-    @property
-    def plastic_depth(self) -> float:
-        """Depth of the grid of :meth:`plastic_steps`, m: 1.5 Hertz radii (first yield of a
-        point contact at 0.48 a, shallower with friction), at most the printed column depth."""
-        return min(1.5 * self.hertz[1], self.stress_depth)
-
     # -- the deck ---------------------------------------------------------------------------
     def write_deck(self, path: str | Path, mesh: Mesh3D, seat: float, refine: int = 1,
                    penalty_scale: float = 1.0) -> Path:
-        """The ccx deck: half model, node-to-surface pair once, seating (REF down by ``seat``
-        m, friction 0.001), the load P / 2 on REF (automatic increments <= 1/4), the cycle as
-        one step per quarter (REF x ramped to +A, 0, -A, 0, increments <= 4 / n_increments,
-        divided by ``refine``), outputs at the loop's offsets: the support's total reaction,
-        REF, both contact faces' displacements, the Gauss-point stresses of the upper contact
-        layer (``UCONT``, the tractions) and of the column sets ``UCOL``/``LCOL``."""
+        """The ccx deck: half model, node-to-surface pair once (:meth:`_write_model`),
+        seating (REF down by ``seat`` m, friction 0.001), the load P / 2 on REF (automatic
+        increments <= 1/4), the cycle as one step per quarter (REF x ramped to +A, 0, -A, 0,
+        increments <= 4 / n_increments, divided by ``refine``), outputs at the loop's
+        offsets (:meth:`_outputs`); ``penalty_scale``: a retry's softer contact."""
         s = self._scaled_settings(penalty_scale)
         lo_m, up_m = self._materials()
         out = io.StringIO()
-        out.write("*HEADING\ntribodem fe3d: crossed cylinders, half model (y >= 0)\n")
-        out.write("*NODE, NSET=NALL\n")
-        for k, (x, y, z) in enumerate(mesh.nodes, start=1):
-            out.write(f"{k}, {_fmt(x)}, {_fmt(y)}, {_fmt(z)}\n")
-        for name, rows, first in (("LOWER", mesh.elements[:mesh.n_lower], 1),
-                                  ("UPPER", mesh.elements[mesh.n_lower:], mesh.n_lower + 1)):
-            out.write(f"*ELEMENT, TYPE=C3D8, ELSET={name}\n")
-            for k, c in enumerate(rows + 1, start=first):
-                out.write(f"{k}, " + ", ".join(str(int(v)) for v in c) + "\n")
-        for name, ids in mesh.node_sets.items():
-            out.write(f"*NSET, NSET={name}\n")
-            _write_ids(out, ids)
-        for name in ("UCONT", "LCONT", "UCOL", "LCOL"):
-            out.write(f"*ELSET, ELSET={name}\n")
-            _write_ids(out, mesh.element_sets[name])
-        out.write("*SURFACE, NAME=SUP, TYPE=ELEMENT\nUCONT, S1\n")
-        out.write("*SURFACE, NAME=SLOW, TYPE=ELEMENT\nLCONT, S2\n")
-        for name, m in (("MLOWER", lo_m), ("MUPPER", up_m)):
-            out.write(f"*MATERIAL, NAME={name}\n*ELASTIC\n{_fmt(m.young)}, {m.poisson}\n")
-            table = m.plastic_table()
-            if table:
-                out.write("*PLASTIC\n" + "".join(f"{_fmt(v)}, {_fmt(e)}\n" for v, e in table))
-        out.write("*SOLID SECTION, ELSET=LOWER, MATERIAL=MLOWER\n"
-                  "*SOLID SECTION, ELSET=UPPER, MATERIAL=MUPPER\n")
-        ref = int(mesh.node_sets["REF"][0])
-        out.write("*EQUATION\n")
-        for nid in mesh.node_sets["UTOP"]:
-            if int(nid) != ref:
-                for d in (1, 3):
-                    out.write(f"2\n{int(nid)}, {d}, 1., {ref}, {d}, -1.\n")
-        k_n = s.normal_penalty(lo_m.young, up_m.young, mesh.h_fine)
-        tension = "" if s.tension is None else f", {_fmt(s.tension)}"
-        out.write("*SURFACE INTERACTION, NAME=SI\n")
-        out.write(f"*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR\n{_fmt(k_n)}{tension}\n")
-        mu = max(s.mu, s.mu_loading)
-        h = mesh.h_fine
-        out.write(f"*FRICTION\n{mu}, {_fmt(s.stick_slope(lo_m.young, up_m.young, h))}\n")
-        sliding = ", SMALL SLIDING" if self.small_sliding else ""
-        out.write(f"*CONTACT PAIR, INTERACTION=SI, TYPE={s.formulation}{sliding}\nSUP, SLOW\n")
+        ref = self._write_model(out, mesh, s, lo_m, up_m)
         n_load = PLASTIC_LOAD_INCREMENTS if self.plastic else 4
         q = self.n_increments // 4
-        _time_points(out, "TLOAD", np.arange(1, 5) / 4.0)  # outputs: 4 per load step
-        _time_points(out, "TQUARTER", np.arange(1, q + 1) / q)
+        write_time_points(out, "TLOAD", np.arange(1, 5) / 4.0)  # outputs: 4 per load step
+        write_time_points(out, "TQUARTER", np.arange(1, q + 1) / q)
         fixed = "SYMY, 2, 2\nLBOT, 1, 3\n"
         out.write("*BOUNDARY\n" + fixed)
 
         def friction(value: float, loading: bool) -> str:
-            k_t = s.stick_slope(lo_m.young, up_m.young, h, loading)
-            return f"*CHANGE FRICTION, INTERACTION=SI\n*FRICTION\n{value}, {_fmt(k_t)}\n"
-
-        def outputs(tp: str) -> str:
-            return (f"*NODE PRINT, NSET=LBOT, TOTALS=ONLY, TIME POINTS={tp}\nRF\n"
-                    f"*NODE PRINT, NSET=REF, TIME POINTS={tp}\nU\n"
-                    f"*NODE PRINT, NSET=UBOT, TIME POINTS={tp}\nU\n"
-                    f"*NODE PRINT, NSET=LTOP, TIME POINTS={tp}\nU\n"
-                    f"*EL PRINT, ELSET=UCONT, TIME POINTS={tp}\nS\n"
-                    f"*EL PRINT, ELSET=UCOL, TIME POINTS={tp}\nS\n"
-                    f"*EL PRINT, ELSET=LCOL, TIME POINTS={tp}\nS\n"
-                    + (f"*EL PRINT, ELSET=UCOL, TIME POINTS={tp}\nPEEQ\n"
-                       f"*EL PRINT, ELSET=LCOL, TIME POINTS={tp}\nPEEQ\n"
-                       if self.plastic else ""))
+            k_t = s.stick_slope(lo_m.young, up_m.young, mesh.h_fine, loading)
+            return f"*CHANGE FRICTION, INTERACTION=SI\n*FRICTION\n{value}, {fmt(k_t)}\n"
 
         refine = max(int(refine), 1)
-        out.write("*STEP, INC=200\n" + _static(0.5, 1.0, 1e-4, 0.5))
+        out.write("*STEP, INC=200\n" + static_step(0.5, 1.0, 1e-4, 0.5))
         out.write(friction(s.mu_loading, True))
-        out.write(f"*BOUNDARY\n{ref}, 1, 1, 0.\n{ref}, 3, 3, {_fmt(-seat)}\n*END STEP\n")
+        out.write(f"*BOUNDARY\n{ref}, 1, 1, 0.\n{ref}, 3, 3, {fmt(-seat)}\n*END STEP\n")
         dt = 1.0 / (n_load * refine)
-        out.write("*STEP, INC=1000\n" + _static(dt, 1.0, dt * 1e-4, dt))
+        out.write("*STEP, INC=1000\n" + static_step(dt, 1.0, dt * 1e-4, dt))
         out.write("*BOUNDARY, OP=NEW\n" + fixed + f"{ref}, 1, 1, 0.\n")
-        out.write(f"*CLOAD\n{ref}, 3, {_fmt(-self.load / 2.0)}\n")
+        out.write(f"*CLOAD\n{ref}, 3, {fmt(-self.load / 2.0)}\n")
         debris = self._debris_faces(mesh) if self._debris_load > 0.0 else ""
         out.write(debris)
-        out.write(outputs("TLOAD") + "*END STEP\n")
+        out.write(self._outputs("TLOAD") + "*END STEP\n")
         dt = 4.0 / (self.n_increments * refine * self.cycle_refine)
         # each quarter starts at a reversal: first slide REVERSAL_SLIDE delta
         dt0 = min(dt, REVERSAL_SLIDE * self.gross_slip_displacement / self.amplitude)
-        targets = (self.amplitude, 0.0, -self.amplitude, 0.0)
+        targets: tuple[float, ...] = (self.amplitude, 0.0, -self.amplitude, 0.0)
         if self._primed():  # the previous cycle's second half: a continuous test's history
             targets = (-self.amplitude, 0.0) + targets
         for k, target in enumerate(targets):
-            out.write("*STEP, INC=10000\n" + _static(dt0, 1.0, min(dt0, dt * 1e-4), dt))
+            out.write("*STEP, INC=10000\n" + static_step(dt0, 1.0, min(dt0, dt * 1e-4), dt))
             if k == 0:
                 out.write(friction(s.mu, False))
-            out.write(f"*BOUNDARY\n{ref}, 1, 1, {_fmt(target)}\n")
-            out.write(outputs("TQUARTER") + "*END STEP\n")
+            out.write(f"*BOUNDARY\n{ref}, 1, 1, {fmt(target)}\n")
+            out.write(self._outputs("TQUARTER") + "*END STEP\n")
         if self.plastic:  # lift the upper body off, load removed: the residual surfaces
             a = self.hertz[1]
             dt = 1.0 / (n_load * refine)
-            out.write("*STEP, INC=1000\n" + _static(dt, 1.0, dt * 1e-4, dt))
+            out.write("*STEP, INC=1000\n" + static_step(dt, 1.0, dt * 1e-4, dt))
             out.write("*BOUNDARY, OP=NEW\n" + fixed + f"{ref}, 1, 1, 0.\n"
-                      f"{ref}, 3, 3, {_fmt(2.0 * a * a / self.radius)}\n"
+                      f"{ref}, 3, 3, {fmt(2.0 * a * a / self.radius)}\n"
                       f"*CLOAD, OP=NEW\n{ref}, 3, 0.\n")
             if debris:  # the debris go with the load
                 out.write(self._debris_faces(mesh, scale=0.0, header="*DLOAD, OP=NEW"))
-            out.write(outputs("TLOAD") + "*END STEP\n")
+            out.write(self._outputs("TLOAD") + "*END STEP\n")
         path = Path(path)
         path.write_text(out.getvalue())
         return path
+
+    def _write_model(self, out: io.StringIO, mesh: Mesh3D, s: ContactSettings,
+                     lower: FEMaterial, upper: FEMaterial) -> int:
+        """The deck's model data: the mesh with the column sets ``UCOL``/``LCOL``, the two
+        materials, the upper body's top tied to REF in x and z, the interface law ``s``
+        (linear penalty with the n2s tension, friction with its stick slope) and the contact
+        pair; returns REF's node id."""
+        out.write("*HEADING\ntribodem fe3d: crossed cylinders, half model (y >= 0)\n")
+        write_mesh3d(out, mesh, ("UCONT", "LCONT", "UCOL", "LCOL"))
+        write_material(out, "MLOWER", lower)
+        write_material(out, "MUPPER", upper)
+        out.write("*SOLID SECTION, ELSET=LOWER, MATERIAL=MLOWER\n"
+                  "*SOLID SECTION, ELSET=UPPER, MATERIAL=MUPPER\n")
+        ref = write_ref_tie(out, mesh, (1, 3))
+        k_n = s.normal_penalty(lower.young, upper.young, mesh.h_fine)
+        tension = "" if s.tension is None else f", {fmt(s.tension)}"
+        out.write("*SURFACE INTERACTION, NAME=SI\n")
+        out.write(f"*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR\n{fmt(k_n)}{tension}\n")
+        mu = max(s.mu, s.mu_loading)
+        k_t = s.stick_slope(lower.young, upper.young, mesh.h_fine)
+        out.write(f"*FRICTION\n{mu}, {fmt(k_t)}\n")
+        sliding = ", SMALL SLIDING" if self.small_sliding else ""
+        out.write(f"*CONTACT PAIR, INTERACTION=SI, TYPE={s.formulation}{sliding}\nSUP, SLOW\n")
+        return ref
+
+    def _outputs(self, tp: str) -> str:
+        """The ``.dat`` outputs at the time points ``tp``: the support's total reaction,
+        REF, both contact faces' displacements, the Gauss-point stresses of the upper
+        contact layer (``UCONT``, the tractions) and of the column sets ``UCOL``/``LCOL``
+        (and their PEEQ with plastic bodies)."""
+        return (f"*NODE PRINT, NSET=LBOT, TOTALS=ONLY, TIME POINTS={tp}\nRF\n"
+                f"*NODE PRINT, NSET=REF, TIME POINTS={tp}\nU\n"
+                f"*NODE PRINT, NSET=UBOT, TIME POINTS={tp}\nU\n"
+                f"*NODE PRINT, NSET=LTOP, TIME POINTS={tp}\nU\n"
+                f"*EL PRINT, ELSET=UCONT, TIME POINTS={tp}\nS\n"
+                f"*EL PRINT, ELSET=UCOL, TIME POINTS={tp}\nS\n"
+                f"*EL PRINT, ELSET=LCOL, TIME POINTS={tp}\nS\n"
+                + (f"*EL PRINT, ELSET=UCOL, TIME POINTS={tp}\nPEEQ\n"
+                   f"*EL PRINT, ELSET=LCOL, TIME POINTS={tp}\nPEEQ\n"
+                   if self.plastic else ""))
 
     # -- the contract ---------------------------------------------------------------------
     def reset(self) -> None:
@@ -743,7 +624,7 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
 
     def _key(self) -> tuple[bytes, ...]:
         """The geometry, the debris pressure and the priming a job was run with."""
-        return (*super()._key(), self._debris_pressure.tobytes(),
+        return (*super()._key(), self.debris_pressure.tobytes(),
                 b"primed" if self._primed() else b"")
 
     def _primed(self) -> bool:
@@ -802,7 +683,7 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         lines = [header]
         for (ids, p, _), face in zip(self._debris_face_loads(mesh).values(), (1, 2),
                                      strict=True):
-            lines += [f"{int(e)}, P{face}, {_fmt(scale * v)}"
+            lines += [f"{int(e)}, P{face}, {fmt(scale * v)}"
                       for e, v in zip(ids, p, strict=True) if v > 0.0]
         return "\n".join(lines) + "\n"
 
@@ -834,7 +715,7 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
                          up[..., 0].ravel(), np.abs(up[..., 1]).ravel())[:, 0]
         gap = np.maximum(up[..., 2] - z_lo.reshape(up.shape[:2]), 0.0)
         gap_w = self._window(gap, 1.0, False)
-        return (p + self._debris_pressure if debris else p), gap_w
+        return (p + self.debris_pressure if debris else p), gap_w
 
     def _start_cycle(self) -> None:
         if not (self._key() == self._job_key and self._served and self._fresh_for_cycle):
@@ -852,11 +733,7 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
     # -- the job --------------------------------------------------------------------------
     def _run_job(self) -> None:
         """Mesh, morph, write, run (retrying with smaller increments) and read one job."""
-        t0 = time.perf_counter()
-        folder = self._folder()
-        folder.mkdir(parents=True, exist_ok=True)
-        mesh = self.morphed_mesh()
-        seat = self._seat(mesh)
+        folder, mesh, seat, t0 = self._job_start()
         t_mesh = time.perf_counter() - t0
         try:
             run, refine, scale, t_deck, t_ccx = self._run_attempts(
@@ -867,17 +744,12 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
             if hint:
                 raise FESolverStopped(f"{err}\n{hint}") from None
             raise
-        t_mesh += t_deck
         t3 = time.perf_counter()
         blocks = read_dat(run.dat)
         states = self._read(blocks, mesh)
         t_read = time.perf_counter() - t3
-        rec = JobRecord(cycle=self._cycle + 1, folder=folder, deck=run.job.with_suffix(".inp"),
-                        cached=run.cached, elements=int(mesh.elements.shape[0]), refine=refine,
-                        penalty_scale=scale,
-                        seconds_mesh=t_mesh, seconds_ccx=t_ccx, seconds_read=t_read,
-                        worn_volume_upper=self.worn_volume("upper", mesh),
-                        worn_volume_lower=self.worn_volume("lower", mesh))
+        rec = self._job_record(folder, mesh, run, refine, scale,
+                               (t_mesh + t_deck, t_ccx, t_read))
         t4 = time.perf_counter()
         self.mesh = mesh
         self._blocks = blocks
@@ -906,7 +778,7 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         ltop = self._cols["lower"][..., 0]
         n_nodes = mesh.nodes.shape[0]
         states = []
-        debris_nodes = 0.0
+        debris_nodes: float | NDArray[np.float64] = 0.0
         if self._debris_load > 0.0:  # the debris face loads on the upper surface nodes
             ids, p, conn = self._debris_face_loads(mesh)["UCONT"]
             area = _projected_area(mesh.nodes[conn])  # the z force of p on a face
@@ -1034,20 +906,11 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
         traction (the extrapolation overshoots in the steep Hertz gradient)."""
         key = (body, t)
         if key not in self._nodal_cache:
-            name = "LCOL" if body == "lower" else "UCOL"
-            block = next(b for b in self._blocks if b.kind == "stresses"
-                         and b.set_name == name and abs(b.time - t) < 1e-9)
-            rows = block.rows
+            rows = self._block("stresses", column_set(body), t).rows
             elems = rows[:, 0].astype(np.int64).reshape(-1, 8)[:, 0]
             conn = self.mesh.elements[elems - 1]
             nodal = np.einsum("kg,mgc->mkc", _EXTRAPOLATE3, rows[:, 2:8].reshape(-1, 8, 6))
-            n_nodes = self.mesh.nodes.shape[0]
-            total = np.zeros((n_nodes, 6))
-            count = np.zeros(n_nodes)
-            np.add.at(total, conn, nodal)
-            np.add.at(count, conn, 1.0)
-            with np.errstate(invalid="ignore", divide="ignore"):
-                avg = total / count[:, None]
+            avg = nodal_mean(conn, nodal, self.mesh.nodes.shape[0])
             st = self._state_of[t]
             top = self._cols[body][..., 0]
             p = np.where(st["p"] > 1e-5 * st["p"].max(), st["p"], 0.0)
@@ -1070,35 +933,20 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
             self._nodal_cache = {key: avg}
         return self._nodal_cache[key]
 
-    def subsurface_stress(self, result: IncrementResult, body: Body = "lower",
-                          depth: float | None = None, nz: int = 33) -> SubsurfaceStress:
-        """Stress under ``body`` for an increment this solver served (the current cycle's
-        job), on ``nz`` depths 0..``depth`` (m; default 3 sqrt(area / pi)) and the window's
-        (x, y) (lower body: lab x = window x + ``result.offset``). Nodal stresses
-        (:meth:`_nodal_stress`) are interpolated along each straight node column (i, j) by
-        the depth below its (worn) surface node, then bilinearly between columns; y < 0 from
-        the mirror (sigma_xy, sigma_yz odd). Frame: x, y, z = depth into the body: sigma_xz
-        = qx under the lower body and -qx in the upper one at the surface (the half-space
-        backend's convention)."""
-        if body not in BODIES:
-            raise ValueError(f"body = {body!r} is not allowed: use 'upper' or 'lower'")
-        t = self._time_of.get(id(result))
-        if t is None:
-            raise ValueError("result is not an increment of the fe3d solver's current job "
-                             "(subsurface stress is kept for the current cycle only)")
-        if int(nz) != nz or nz < 2:
-            raise ValueError(f"nz = {nz!r} is not allowed: must be an integer >= 2")
-        if depth is None:
-            depth = 3.0 * math.sqrt(max(result.contact_area, self.dx**2) / math.pi)
-        depth = _check_positive("depth", depth)
-        check_stress_depth(depth, self.stress_depth, self.name)  # else exit 3, saying how
-        x = self.coords + (result.offset if body == "lower" else 0.0)
-        z = np.linspace(0.0, depth, int(nz))
+    def _default_grid_depth(self, result: IncrementResult) -> float:
+        """3 contact radii, 3 sqrt(area / pi), m."""
+        return 3.0 * math.sqrt(max(result.contact_area, self.dx**2) / math.pi)
+
+    def _stress_on_grid(self, body: str, t: float, x: NDArray[np.float64],
+                        z: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Nodal stresses (:meth:`_nodal_stress`) interpolated along each straight node
+        column (i, j) by the depth below its (worn) surface node, then bilinearly between
+        columns; y < 0 from the mirror (sigma_xy, sigma_yz odd). Frame: x, y, z = depth into
+        the body: sigma_xz = qx under the lower body and -qx in the upper one at the surface
+        (the half-space backend's convention)."""
         s = self._column_grid(body, self._nodal_stress(body, t), _STRESS_MIRROR, x, z,
                               "stresses")
-        voigt = _voigt(s, body)
-        return SubsurfaceStress(body=body, z=z, x=self.coords, y=self.coords, stress=voigt,
-                                von_mises=von_mises(voigt), tresca=max_shear(voigt))
+        return _voigt(s, body)
 
     def _column_grid(self, body: str, nodal: NDArray[np.float64], mirror: NDArray[np.float64],
                      x: NDArray[np.float64], z: NDArray[np.float64], what: str
@@ -1138,31 +986,9 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
                              f"{z[-1]:.4g} m on the {body} body")
         return np.moveaxis(out, 2, 0)
 
-    # -- plastic strain -------------------------------------------------------------------
-    def _nodal_peeq(self, body: str, t: float) -> NDArray[np.float64]:
-        """Equivalent plastic strain at the nodes at total time ``t``, [n_nodes, 1] (NaN off
-        the column set): each node takes the mean, over the elements around it, of the
-        element's Gauss point nearest to it (no extrapolation: >= 0, no overshoot at the
-        surface where plastic strain is steepest)."""
-        key = ("peeq", body, t)
-        if key not in self._peeq_cache:
-            elems, ip = self._peeq_ip(body, t)
-            conn = self.mesh.elements[elems - 1]
-            n_nodes = self.mesh.nodes.shape[0]
-            total = np.zeros(n_nodes)
-            count = np.zeros(n_nodes)
-            np.add.at(total, conn, ip[:, _NEAREST_GAUSS3])
-            np.add.at(count, conn, 1.0)
-            with np.errstate(invalid="ignore", divide="ignore"):
-                self._peeq_cache[key] = (total / count)[:, None]
-        return self._peeq_cache[key]
-
     def _peeq_ip(self, body: str, t: float) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
         """(elements, PEEQ at their 8 Gauss points [m, 8]) of ``body``'s column set at ``t``."""
-        name = "LCOL" if body == "lower" else "UCOL"
-        block = next(b for b in self._blocks if b.kind == "equivalent plastic strain"
-                     and b.set_name == name and abs(b.time - t) < 1e-9)
-        rows = block.rows
+        rows = self._block("equivalent plastic strain", column_set(body), t).rows
         return rows[:, 0].astype(np.int64).reshape(-1, 8)[:, 0], rows[:, 2].reshape(-1, 8)
 
     def _peeq_peak(self, body: str, t: float) -> tuple[float, float]:
@@ -1189,8 +1015,7 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
             load = float(abs(self._state_of[t]["force"][2]))
             for body in BODIES:
                 x = self._plastic_grid_x(body)
-                now = self._nodal_peeq(body, t)
-                dp_nodal = now if prev is None else now - self._nodal_peeq(body, prev)
+                dp_nodal = self._peeq_increment(body, t, prev)
                 dp = np.maximum(self._column_grid(body, dp_nodal, _ONE, x, z,
                                                   "plastic strain")[..., 0], 0.0)
                 stress = _voigt(self._column_grid(body, self._nodal_stress(body, t),
@@ -1202,53 +1027,35 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
 
     # -- what a cycle measured -------------------------------------------------------------
     def _cycle_report(self) -> dict[str, Any]:
-        """Peak stresses, plastic strain, pile-up and traction of the job just run (one
-        fretting cycle from virgin bodies); see :meth:`report`."""
+        """What the job just run (one fretting cycle from virgin bodies) measured, its row of
+        :meth:`report`'s ``cycles``: max von Mises and max S22 (the vertical normal stress,
+        ccx S33; compressive and tensile) over the column sets' Gauss points at the loaded
+        state and every output increment (:meth:`_peak_stresses`); with plastic bodies the
+        max equivalent plastic strain per body and its depth at the cycle's end and at the
+        loaded state (``max_peeq_loaded_*``: Johnson's first yield, below the surface), the
+        residual pile-up and dent after lifting the upper body off
+        (:func:`.base.residual_surfaces`); the largest shear traction in the cycle's first
+        and last quarters and the drop between them (:func:`.base.traction_quarters`),
+        |Q| / (mu P) at +A and -A; the ccx attempt the cycle's job converged on
+        (:meth:`.jobs.CcxJobs._attempt_report`); with ``max_wear_slope``, what the slope
+        limit did to the job's surfaces."""
         times = sorted(self._state_of)
-        row: dict[str, Any] = {"cycle": self._cycle + 1} | self._attempt_report()
-        peaks = np.zeros((len(times), 3))  # per output time: von Mises, -S33, S33
-        for name in ("UCOL", "LCOL"):
-            for k, t in enumerate(times):
-                block = next(b for b in self._blocks if b.kind == "stresses"
-                             and b.set_name == name and abs(b.time - t) < 1e-9)
-                sv = block.rows[:, 2:8]
-                vm = np.sqrt(0.5 * ((sv[:, 0] - sv[:, 1]) ** 2 + (sv[:, 1] - sv[:, 2]) ** 2
-                                    + (sv[:, 2] - sv[:, 0]) ** 2)
-                             + 3.0 * (sv[:, 3] ** 2 + sv[:, 4] ** 2 + sv[:, 5] ** 2))
-                peaks[k] = np.maximum(peaks[k], (vm.max(), -sv[:, 2].min(), sv[:, 2].max()))
-        k_c = int(np.argmax(peaks[:, 1]))
-        row |= {"max_von_mises_pa": float(peaks[:, 0].max()),
-                "max_s22_compressive_pa": float(peaks[k_c, 1]),
-                "max_s22_tensile_pa": float(peaks[:, 2].max()),
-                # where the cycle's peak compression sits (the upper body's x offset, m),
-                # and the peaks at the loaded state before sliding (seed: 1.6 / 1.4 GPa)
-                "max_s22_compressive_offset_m": float(self._state_of[times[k_c]]["u_ref"][0]),
-                "max_von_mises_loaded_pa": float(peaks[0, 0]),
-                "max_s22_compressive_loaded_pa": float(peaks[0, 1])}
+        row: dict[str, Any] = ({"cycle": self._cycle + 1} | self._attempt_report()
+                               | self._peak_stresses(times))
         if self.plastic:
             for body in BODIES:
                 for label, t in (("", times[-1]), ("loaded_", times[0])):
                     peak, depth = self._peeq_peak(body, t)
                     row[f"max_peeq_{label}{body}"] = peak
                     row[f"max_peeq_{label}depth_{body}_m"] = depth
-            # after lifting the upper body off: pile-up (largest rise of the lower surface,
-            # and of the upper one towards it relative to REF) and dent (deepest depression)
+            # after lifting the upper body off (the upper surface relative to REF)
             t_off = max(b.time for b in self._blocks if b.kind == "displacements")
-            u = {name: next(b for b in self._blocks if b.kind == "displacements"
-                            and b.set_name == name and abs(b.time - t_off) < 1e-9).rows
+            u = {name: self._block("displacements", name, t_off).rows
                  for name in ("UBOT", "LTOP", "REF")}
-            u_lo = u["LTOP"][:, 3]
-            u_up = u["UBOT"][:, 3] - u["REF"][0, 3]
-            row |= {"pile_up_lower_m": float(max(u_lo.max(), 0.0)),
-                    "dent_lower_m": float(max(-u_lo.min(), 0.0)),
-                    "pile_up_upper_m": float(max(-u_up.min(), 0.0)),
-                    "dent_upper_m": float(max(u_up.max(), 0.0))}
-        q = np.array([float(np.hypot(*np.moveaxis(i.traction, -1, 0)).max())
-                      for i in self._served])
-        quarter = max(len(q) // 4, 1)
-        first, last = float(q[:quarter].max()), float(q[-quarter:].max())
-        row |= {"max_traction_first_quarter_pa": first, "max_traction_last_quarter_pa": last,
-                "traction_drop": (last - first) / first if first > 0 else 0.0}
+            row |= residual_surfaces(u["LTOP"][:, 3], u["UBOT"][:, 3] - u["REF"][0, 3])
+        row |= traction_quarters(np.array([float(np.hypot(*np.moveaxis(i.traction, -1, 0)).max())
+                                           for i in self._served]))
+        quarter = max(len(self._served) // 4, 1)
         fx = [abs(float(self._state_of[times[k]]["force"][0])) for k in (quarter, 3 * quarter)]
         row["q_over_mu_p_at_plus_minus_a"] = [v / (self.friction * self.load) for v in fx]
         if self.max_wear_slope is not None and self.slope_limits:
@@ -1262,25 +1069,33 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
                    for body, lim in self.slope_limits.items()}}
         return row
 
-    def report(self) -> dict[str, Any]:
-        """For summary.json: the mesh, material, the jobs' mean time profile (s) and per
-        cycle (:meth:`_cycle_report`): max von Mises and max S22 (the vertical normal stress,
-        ccx S33; compressive and tensile) over the column sets' Gauss points at the loaded
-        state and every output increment; with plastic bodies the max equivalent plastic
-        strain per body and its depth at the cycle's end and at the loaded state
-        (``max_peeq_loaded_*``: Johnson's first yield, below the surface), the residual
-        pile-up and dent
-        after lifting the upper body off; the largest shear traction in the cycle's first
-        and last quarters and the drop between them, |Q| / (mu P) at +A and -A; the ccx
-        attempt the cycle's job converged on (:meth:`.jobs.CcxJobs._attempt_report`)."""
-        return {"backend": "fe3d", "mode": self.mode, "material": self.material,
-                "plastic_law": self._law_report(),
-                "ccx": ccx_build(self.executable),
-                "fe3d": {"elements": int(self._mesh0.elements.shape[0]),
-                         "h_fine_m": self._mesh0.h_fine, "size_factor": self.size_factor,
-                         "max_wear_slope": self.max_wear_slope,
-                         "worn_surface": self._worn_surface_reading()},
-                "profile": self.profile(), "cycles": list(self.cycle_reports)}
+    def _peak_stresses(self, times: list[float]) -> dict[str, float]:
+        """Max von Mises and max S33 (compressive, with the upper body's x offset where it
+        sits, and tensile) over the column sets' Gauss points at the total ``times`` (the
+        first the loaded state: its peaks too), Pa."""
+        peaks = np.zeros((len(times), 3))  # per output time: von Mises, -S33, S33
+        for name in ("UCOL", "LCOL"):
+            for k, t in enumerate(times):
+                sv = self._block("stresses", name, t).rows[:, 2:8]
+                vm = np.sqrt(0.5 * ((sv[:, 0] - sv[:, 1]) ** 2 + (sv[:, 1] - sv[:, 2]) ** 2
+                                    + (sv[:, 2] - sv[:, 0]) ** 2)
+                             + 3.0 * (sv[:, 3] ** 2 + sv[:, 4] ** 2 + sv[:, 5] ** 2))
+                peaks[k] = np.maximum(peaks[k], (vm.max(), -sv[:, 2].min(), sv[:, 2].max()))
+        k_c = int(np.argmax(peaks[:, 1]))
+        return {"max_von_mises_pa": float(peaks[:, 0].max()),
+                "max_s22_compressive_pa": float(peaks[k_c, 1]),
+                "max_s22_tensile_pa": float(peaks[:, 2].max()),
+                # where the cycle's peak compression sits (the upper body's x offset, m),
+                # and the peaks at the loaded state before sliding (seed: 1.6 / 1.4 GPa)
+                "max_s22_compressive_offset_m": float(self._state_of[times[k_c]]["u_ref"][0]),
+                "max_von_mises_loaded_pa": float(peaks[0, 0]),
+                "max_s22_compressive_loaded_pa": float(peaks[0, 1])}
+
+    def _block(self, kind: str, set_name: str, t: float) -> DatBlock:
+        """The last job's ``.dat`` block of ``kind`` for set ``set_name`` at total time
+        ``t``."""
+        return next(b for b in self._blocks if b.kind == kind and b.set_name == set_name
+                    and abs(b.time - t) < 1e-9)
 
     def _steepness_hint(self) -> str:
         """What to do when a job on worn surfaces steeper than :data:`CONVERGED_SLOPE` did
@@ -1311,34 +1126,21 @@ class FE3DContactSolver(CcxJobs, FirstBodySolver):
                 "'wear_slope_limit' gives the steepest step before and after and the volume "
                 "moved")
 
-    # -- resume ---------------------------------------------------------------------------
-    def state_dict(self) -> dict[str, Any]:
-        """A fresh-mode solver holds no load history between cycles: the cycle counter,
-        whether the bodies were loaded, the mode and the work folder."""
-        return {"cycle": self._cycle, "loaded": self._loaded, "mode": self.mode,
-                "material": self.material, "cycle_reports": list(self.cycle_reports),
-                "debris_pressure": self._debris_pressure.copy(), "debris_load": self._debris_load,
-                "last_attempt": self._last_attempt,
-                "workdir": None if self.workdir is None else str(self.workdir)}
+    def _report_extra(self) -> dict[str, Any]:
+        """The mesh (elements, fine element size m, size factor), the slope limit and which
+        worn surface the meshes carry."""
+        return {"fe3d": {"elements": int(self._mesh0.elements.shape[0]),
+                         "h_fine_m": self._mesh0.h_fine, "size_factor": self.size_factor,
+                         "max_wear_slope": self.max_wear_slope,
+                         "worn_surface": self._worn_surface_reading()}}
 
-    def load_state_dict(self, state: dict[str, Any]) -> None:
-        """Restore :meth:`state_dict` (the next cycle runs its own job)."""
-        if state.get("mode", "fresh") != self.mode:
-            raise ValueError(f"saved fe3d mode {state.get('mode')!r}, this solver "
-                             f"{self.mode!r}")
-        if state.get("material", "elastic") != self.material:
-            raise ValueError(f"saved fe3d material {state.get('material')!r}, this solver "
-                             f"{self.material!r}")
-        self._cycle = int(state["cycle"])
-        self._loaded = bool(state["loaded"])
-        self._k = None
-        self._job_key = None
-        self._served = []
-        self._pending = []
-        self.cycle_reports = list(state.get("cycle_reports", []))
+    # -- resume ---------------------------------------------------------------------------
+    def _state_extra(self) -> dict[str, Any]:
+        """The cycle reports and the prescribed debris pressure (Pa) and load (N)."""
+        return {"cycle_reports": list(self.cycle_reports),
+                "debris_pressure": self.debris_pressure.copy(), "debris_load": self._debris_load}
+
+    def _load_state_extra(self, state: dict[str, Any]) -> None:
         if "debris_pressure" in state:
             self._debris_pressure = np.array(state["debris_pressure"], dtype=float)
             self._debris_load = float(state["debris_load"])
-        if self.workdir is None and state.get("workdir"):
-            self.workdir = Path(state["workdir"])
-        self._restore_last_attempt(state)

@@ -1,4 +1,4 @@
-"""3D crossed-cylinder model on CalculiX (seed 003 figure 3.4; issue 14 item 2): quarter model.
+"""3D crossed-cylinder model on CalculiX (seed 003 figure 3.4): quarter model.
 
 Geometry (SI, metres): the *upper* cylinder's axis is along y, the *lower* cylinder's along x
 (the stroke is along x); they touch at the origin, z up. Under a normal load the problem has
@@ -41,10 +41,11 @@ from tribodem.contact.fe.ccx import run_ccx
 from tribodem.contact.fe.deck import (
     ContactSettings,
     FEMaterial,
-    _fmt,
-    _static,
-    _time_points,
-    _write_ids,
+    fmt,
+    static_step,
+    write_ids,
+    write_material,
+    write_time_points,
 )
 from tribodem.contact.fe.mesh import graded_half, graded_symmetric
 from tribodem.contact.fe.results import read_dat, tributary_length
@@ -118,7 +119,7 @@ class Mesh3D:
         """Raise ValueError on an inverted element (negative Jacobian at a Gauss point)."""
         x = self.nodes[self.elements]
         for g in GAUSS_2X2X2:
-            det = np.linalg.det(np.einsum("nki,kj->nij", x, _dshape(g)))
+            det = np.linalg.det(np.einsum("nki,kj->nij", x, dshape(g)))
             if np.any(det <= 0):
                 raise ValueError("inverted C3D8 element in the crossed-cylinder mesh")
 
@@ -133,7 +134,7 @@ class Mesh3D:
         return Path(path)
 
 
-def _dshape(xi: NDArray[np.float64]) -> NDArray[np.float64]:
+def dshape(xi: NDArray[np.float64]) -> NDArray[np.float64]:
     """Derivatives of the 8 trilinear shape functions w.r.t. (xi, eta, zeta), [8, 3]."""
     s = NODE_XI
     d = np.empty((8, 3))
@@ -238,16 +239,14 @@ def crossed_mesh(case: CrossedCase, a: float | None = None, shift_lower: float =
     return mesh
 
 
-def write_crossed_deck(path: str | Path, mesh: Mesh3D, case: CrossedCase) -> Path:
-    """The ccx deck (``.inp``): seating, the normal load, and with ``case.delta`` the
-    tangential cycle of REF along x (as the 2D deck, :mod:`tribodem.contact.fe.deck`)."""
-    m = case.material
-    out = io.StringIO()
-    out.write("*HEADING\ntribodem fe: crossed cylinders, "
-              f"{'half' if case.half else 'quarter'} model\n")
+def write_mesh3d(out: io.StringIO, mesh: Mesh3D, element_sets: tuple[str, ...]) -> None:
+    """Write the mesh of a 3D deck: the nodes (m, ``NSET=NALL``), the C3D8 elements of both
+    bodies (``ELSET=LOWER``, ``UPPER``), every node set, the element sets ``element_sets``
+    and the contact surfaces ``SUP`` (the upper body's ``UCONT`` faces S1) and ``SLOW`` (the
+    lower body's ``LCONT`` faces S2)."""
     out.write("*NODE, NSET=NALL\n")
     for k, (x, y, z) in enumerate(mesh.nodes, start=1):
-        out.write(f"{k}, {_fmt(x)}, {_fmt(y)}, {_fmt(z)}\n")
+        out.write(f"{k}, {fmt(x)}, {fmt(y)}, {fmt(z)}\n")
     for name, rows, first in (("LOWER", mesh.elements[:mesh.n_lower], 1),
                               ("UPPER", mesh.elements[mesh.n_lower:], mesh.n_lower + 1)):
         out.write(f"*ELEMENT, TYPE=C3D8, ELSET={name}\n")
@@ -255,71 +254,84 @@ def write_crossed_deck(path: str | Path, mesh: Mesh3D, case: CrossedCase) -> Pat
             out.write(f"{k}, " + ", ".join(str(int(v)) for v in c) + "\n")
     for name, ids in mesh.node_sets.items():
         out.write(f"*NSET, NSET={name}\n")
-        _write_ids(out, ids)
-    for name in ("UCONT", "LCONT"):
+        write_ids(out, ids)
+    for name in element_sets:
         out.write(f"*ELSET, ELSET={name}\n")
-        _write_ids(out, mesh.element_sets[name])
+        write_ids(out, mesh.element_sets[name])
     # faces: C3D8 S1 = nodes 1-2-3-4 (zeta = -1, the upper body's bottom), S2 = 5-8-7-6 (top)
     out.write("*SURFACE, NAME=SUP, TYPE=ELEMENT\nUCONT, S1\n")
     out.write("*SURFACE, NAME=SLOW, TYPE=ELEMENT\nLCONT, S2\n")
-    out.write(f"*MATERIAL, NAME=M\n*ELASTIC\n{_fmt(m.young)}, {m.poisson}\n")
-    table = m.plastic_table()
-    if table:
-        out.write("*PLASTIC\n" + "".join(f"{_fmt(a)}, {_fmt(b)}\n" for a, b in table))
-    out.write("*SOLID SECTION, ELSET=LOWER, MATERIAL=M\n*SOLID SECTION, ELSET=UPPER, "
-              "MATERIAL=M\n")
+
+
+def write_ref_tie(out: io.StringIO, mesh: Mesh3D, dofs: tuple[int, ...]) -> int:
+    """Write the ``*EQUATION`` tying the degrees of freedom ``dofs`` of every node of the
+    upper body's top (``UTOP``) to the reference node ``REF``; returns REF's id."""
     ref = int(mesh.node_sets["REF"][0])
-    dofs = (1, 3) if case.half else (3,)
     out.write("*EQUATION\n")
     for n in mesh.node_sets["UTOP"]:
         if int(n) != ref:
             for d in dofs:
                 out.write(f"2\n{int(n)}, {d}, 1., {ref}, {d}, -1.\n")
+    return ref
+
+
+def write_crossed_deck(path: str | Path, mesh: Mesh3D, case: CrossedCase) -> Path:
+    """The ccx deck (``.inp``): seating, the normal load, and with ``case.delta`` the
+    tangential cycle of REF along x (as the 2D deck, :mod:`tribodem.contact.fe.deck`)."""
+    m = case.material
+    out = io.StringIO()
+    out.write("*HEADING\ntribodem fe: crossed cylinders, "
+              f"{'half' if case.half else 'quarter'} model\n")
+    write_mesh3d(out, mesh, ("UCONT", "LCONT"))
+    write_material(out, "M", m)
+    out.write("*SOLID SECTION, ELSET=LOWER, MATERIAL=M\n*SOLID SECTION, ELSET=UPPER, "
+              "MATERIAL=M\n")
+    ref = write_ref_tie(out, mesh, (1, 3) if case.half else (3,))
     c = case.contact
     k_n = c.normal_penalty(m.young, m.young, mesh.h_fine)
     out.write("*SURFACE INTERACTION, NAME=SI\n")
-    out.write(f"*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR\n{_fmt(k_n)}\n")
+    out.write(f"*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR\n{fmt(k_n)}\n")
     friction = case.half and c.mu > 0
     if friction:
         out.write(f"*FRICTION\n{c.mu_loading}, "
-                  f"{_fmt(c.stick_slope(m.young, m.young, mesh.h_fine, loading=True))}\n")
+                  f"{fmt(c.stick_slope(m.young, m.young, mesh.h_fine, loading=True))}\n")
     out.write("*CONTACT PAIR, INTERACTION=SI, TYPE=SURFACE TO SURFACE\nSUP, SLOW\n")
     out.write("*AMPLITUDE, NAME=STROKE\n0., 0., 1., 1., 2., 0., 3., -1.\n4., 0.\n")
     fixed = "*BOUNDARY\nSYMY, 2, 2\nLBOT, 1, 3\n" if case.half else \
         "*BOUNDARY\nSYMX, 1, 1\nSYMY, 2, 2\nLBOT, 3, 3\n"
     hold = f"{ref}, 1, 1, 0.\n" if case.half else ""
     n = max(int(case.load_increments), 1)
-    _time_points(out, "TLOAD", np.arange(1, n + 1) / n)
+    write_time_points(out, "TLOAD", np.arange(1, n + 1) / n)
     nt = int(case.n_increments)
     if case.half:
         if nt < 4 or nt % 4:
             raise ValueError(f"n_increments = {nt!r}: must be a multiple of 4, >= 4")
         steps = nt // 4 if case.half_cycle else nt
-        _time_points(out, "TCYCLE", np.arange(1, steps + 1) * (4.0 / nt))
+        write_time_points(out, "TCYCLE", np.arange(1, steps + 1) * (4.0 / nt))
     out.write(fixed)
     _, a = case.hertz
     seat = 0.05 * a * a / case.radius  # 5 % of the Hertz approach a^2 / R
-    out.write("*STEP, INC=200\n" + _static(0.5, 1.0, 1e-4, 0.5))
-    out.write(f"*BOUNDARY\n{hold}{ref}, 3, 3, {_fmt(-seat)}\n*END STEP\n")
+    out.write("*STEP, INC=200\n" + static_step(0.5, 1.0, 1e-4, 0.5))
+    out.write(f"*BOUNDARY\n{hold}{ref}, 3, 3, {fmt(-seat)}\n*END STEP\n")
     dt = 1.0 / n
     outputs = ("*NODE PRINT, NSET=LBOT, TOTALS=ONLY, TIME POINTS={tp}\nRF\n"
                "*NODE PRINT, NSET=REF, TIME POINTS={tp}\nU\n"
                "*NODE PRINT, NSET=UBOT, TIME POINTS={tp}\nU\n"
                "*NODE PRINT, NSET=LTOP, TIME POINTS={tp}\nU\n"
                "*EL PRINT, ELSET=UCONT, TIME POINTS={tp}\nS\n")
-    out.write("*STEP, INC=1000\n" + _static(dt, 1.0, dt * 1e-4, dt))
+    out.write("*STEP, INC=1000\n" + static_step(dt, 1.0, dt * 1e-4, dt))
     out.write("*BOUNDARY, OP=NEW\n" + fixed.split("\n", 1)[1] + hold)
-    out.write(f"*CLOAD\n{ref}, 3, {_fmt(-case.load / (2.0 if case.half else 4.0))}\n")
+    out.write(f"*CLOAD\n{ref}, 3, {fmt(-case.load / (2.0 if case.half else 4.0))}\n")
     out.write(outputs.format(tp="TLOAD") + "*END STEP\n")
     if case.half:
         dt = 4.0 / nt
         total = 1.0 if case.half_cycle else 4.0
-        out.write("*STEP, INC=10000\n" + _static(dt, total, dt * 1e-4, dt))
+        out.write("*STEP, INC=10000\n" + static_step(dt, total, dt * 1e-4, dt))
         if friction:
             out.write("*CHANGE FRICTION, INTERACTION=SI\n"
                       f"*FRICTION\n{c.mu}, "
-                      f"{_fmt(c.stick_slope(m.young, m.young, mesh.h_fine))}\n")
-        out.write(f"*BOUNDARY, AMPLITUDE=STROKE\n{ref}, 1, 1, {_fmt(case.delta)}\n")
+                      f"{fmt(c.stick_slope(m.young, m.young, mesh.h_fine))}\n")
+        out.write(f"*BOUNDARY, AMPLITUDE=STROKE\n{ref}, 1, 1, {fmt(case.delta)}\n")
         out.write(outputs.format(tp="TCYCLE") + "*END STEP\n")
     path = Path(path)
     path.write_text(out.getvalue())
@@ -339,7 +351,7 @@ def element_forces(x: NDArray[np.float64], stress: NDArray[np.float64]
         sig[..., i, j] = sig[..., j, i] = stress[..., c]
     f = np.zeros(x.shape)
     for g, xi in enumerate(GAUSS_2X2X2):
-        dn = _dshape(xi)  # [8, 3]
+        dn = dshape(xi)  # [8, 3]
         jac = np.einsum("mki,kj->mij", x, dn)  # d x_i / d xi_j
         grad = np.einsum("kj,mji->mki", dn, np.linalg.inv(jac))  # d N_k / d x_i
         f += np.einsum("mki,mil->mkl", grad, sig[:, g]) * np.linalg.det(jac)[:, None, None]

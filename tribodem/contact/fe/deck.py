@@ -39,6 +39,7 @@ from __future__ import annotations
 
 import io
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -187,13 +188,24 @@ class LoadCase:
     unload: bool = False
 
 
-def _fmt(v: float) -> str:
+def fmt(v: float) -> str:
+    """A deck's number field: ``v`` with 10 significant digits (at most 16 characters)."""
     return f"{v:.9e}"
 
 
-def _write_ids(out: io.StringIO, ids: np.ndarray, per_line: int = 16) -> None:
+def write_ids(out: io.StringIO, ids: np.ndarray, per_line: int = 16) -> None:
+    """Write the 1-based ``ids`` of a set's data lines, ``per_line`` to a line."""
     for k in range(0, ids.size, per_line):
         out.write(", ".join(str(int(i)) for i in ids[k:k + per_line]) + "\n")
+
+
+def write_material(out: io.StringIO, name: str, mat: FEMaterial) -> None:
+    """Write ``*MATERIAL`` ``name``: ``*ELASTIC`` E (Pa) and nu and, for a plastic one, its
+    ``*PLASTIC`` rows (true stress Pa, equivalent plastic strain)."""
+    out.write(f"*MATERIAL, NAME={name}\n*ELASTIC\n{fmt(mat.young)}, {mat.poisson}\n")
+    table = mat.plastic_table()
+    if table:
+        out.write("*PLASTIC\n" + "".join(f"{fmt(s)}, {fmt(e)}\n" for s, e in table))
 
 
 def _model_data(out: io.StringIO, mesh: Mesh, lower: FEMaterial, upper: FEMaterial,
@@ -201,7 +213,7 @@ def _model_data(out: io.StringIO, mesh: Mesh, lower: FEMaterial, upper: FEMateri
     out.write("*HEADING\ntribodem fe: plane-strain cylindrical pad on flat\n")
     out.write("*NODE, NSET=NALL\n")
     for k, (x, y) in enumerate(mesh.nodes, start=1):
-        out.write(f"{k}, {_fmt(x)}, {_fmt(y)}\n")
+        out.write(f"{k}, {fmt(x)}, {fmt(y)}\n")
     n_low = mesh.element_sets["LOWER"].size
     for name, rows, first in (("LOWER", mesh.elements[:n_low], 1),
                               ("UPPER", mesh.elements[n_low:], n_low + 1)):
@@ -210,23 +222,18 @@ def _model_data(out: io.StringIO, mesh: Mesh, lower: FEMaterial, upper: FEMateri
             out.write(f"{k}, {conn[0]}, {conn[1]}, {conn[2]}, {conn[3]}\n")
     for name, ids in mesh.node_sets.items():
         out.write(f"*NSET, NSET={name}\n")
-        _write_ids(out, ids)
+        write_ids(out, ids)
     for name, ids in mesh.element_sets.items():
         if name not in ("LOWER", "UPPER"):
             out.write(f"*ELSET, ELSET={name}\n")
-            _write_ids(out, ids)
+            write_ids(out, ids)
     out.write("*ELSET, ELSET=FINE\nLFINE, UFINE\n")
     for name, (ids, face) in mesh.surfaces.items():
         out.write(f"*SURFACE, NAME={name}, TYPE=ELEMENT\n")
         for e in ids:
             out.write(f"{int(e)}, S{face + 1}\n")
     for name, mat in (("MLOWER", lower), ("MUPPER", upper)):
-        out.write(f"*MATERIAL, NAME={name}\n*ELASTIC\n{_fmt(mat.young)}, {mat.poisson}\n")
-        table = mat.plastic_table()
-        if table:
-            out.write("*PLASTIC\n")
-            for s, e in table:
-                out.write(f"{_fmt(s)}, {_fmt(e)}\n")
+        write_material(out, name, mat)
     out.write("*SOLID SECTION, ELSET=LOWER, MATERIAL=MLOWER\n1.\n")
     out.write("*SOLID SECTION, ELSET=UPPER, MATERIAL=MUPPER\n1.\n")
     ref = int(mesh.node_sets["REF"][0])
@@ -237,11 +244,11 @@ def _model_data(out: io.StringIO, mesh: Mesh, lower: FEMaterial, upper: FEMateri
                 out.write(f"2\n{int(n)}, {dof}, 1., {ref}, {dof}, -1.\n")
     k_n = contact.normal_penalty(lower.young, upper.young, mesh.h_fine)
     out.write("*SURFACE INTERACTION, NAME=SI\n")
-    tension = "" if contact.tension is None else f", {_fmt(contact.tension)}"
-    out.write(f"*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR\n{_fmt(k_n)}{tension}\n")
+    tension = "" if contact.tension is None else f", {fmt(contact.tension)}"
+    out.write(f"*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR\n{fmt(k_n)}{tension}\n")
     if contact.mu > 0:
         k_t = contact.stick_slope(lower.young, upper.young, mesh.h_fine)
-        out.write(f"*FRICTION\n{contact.mu}, {_fmt(k_t)}\n")
+        out.write(f"*FRICTION\n{contact.mu}, {fmt(k_t)}\n")
     if contact.pair_in_model:
         out.write(f"*CONTACT PAIR, INTERACTION=SI, TYPE={contact.formulation}\nSPAD, SFLAT\n")
 
@@ -252,12 +259,12 @@ def _change_friction(out: io.StringIO, mesh: Mesh, lower: FEMaterial, upper: FEM
         mu = contact.mu_loading if loading else contact.mu
         k_t = contact.stick_slope(lower.young, upper.young, mesh.h_fine, loading)
         out.write("*CHANGE FRICTION, INTERACTION=SI\n")
-        out.write(f"*FRICTION\n{mu}, {_fmt(k_t)}\n")
+        out.write(f"*FRICTION\n{mu}, {fmt(k_t)}\n")
     if not contact.pair_in_model:
         out.write(f"*CONTACT PAIR, INTERACTION=SI, TYPE={contact.formulation}\nSPAD, SFLAT\n")
 
 
-def _static(initial: float, period: float, minimum: float, maximum: float) -> str:
+def static_step(initial: float, period: float, minimum: float, maximum: float) -> str:
     """A ``*STATIC`` keyword with its data line: initial increment, step period, minimum and
     maximum increment (step time). ccx reads each field as at most 20 characters: a
     ``repr`` such as ``8.333333333333334e-06`` (21) loses its exponent's last digit and
@@ -266,7 +273,8 @@ def _static(initial: float, period: float, minimum: float, maximum: float) -> st
     return "*STATIC\n" + ", ".join(f"{v:.12g}" for v in (initial, period, minimum, maximum)) + "\n"
 
 
-def _time_points(out: io.StringIO, name: str, times: np.ndarray) -> None:
+def write_time_points(out: io.StringIO, name: str, times: np.ndarray) -> None:
+    """Write a ``*TIME POINTS`` card ``name`` with ``times`` (step time), 8 to a line."""
     out.write(f"*TIME POINTS, NAME={name}\n")
     for k in range(0, times.size, 8):
         out.write(", ".join(f"{t:.12g}" for t in times[k:k + 8]) + "\n")
@@ -317,61 +325,78 @@ def write_deck(path: str | Path, mesh: Mesh, case: LoadCase,
     _model_data(out, mesh, lower, upper, contact)
     out.write("*AMPLITUDE, NAME=STROKE\n0., 0., 1., 1., 2., 0., 3., -1.\n4., 0.\n")
     n_load = max(int(case.load_increments), 1)
-    total = 1.0 if case.half_cycle else 4.0
     n_tan = n // 4 if case.half_cycle else n
-    _time_points(out, "TLOAD", np.arange(1, n_load + 1) / n_load)
+    write_time_points(out, "TLOAD", np.arange(1, n_load + 1) / n_load)
     if case.delta > 0 and case.split_cycle:
-        _time_points(out, "TQUARTER", np.arange(1, n // 4 + 1) / (n // 4))
+        write_time_points(out, "TQUARTER", np.arange(1, n // 4 + 1) / (n // 4))
     elif case.delta > 0:
-        _time_points(out, "TCYCLE", np.arange(1, n_tan + 1) * (4.0 / n))
+        write_time_points(out, "TCYCLE", np.arange(1, n_tan + 1) * (4.0 / n))
     out.write("*BOUNDARY\nLBOT, 1, 2\n")
     controls = ""
     if case.field_controls is not None:
         r_n, c_n = case.field_controls
         controls = f"*CONTROLS, PARAMETERS=FIELD\n{r_n}, {c_n}\n"
+    def outputs(time_points: str) -> None:
+        _outputs(out, plastic, fine_stress, frd, time_points, stress_sets)
+
+    def sliding_friction() -> None:
+        _change_friction(out, mesh, lower, upper, contact, loading=False)
+
     # step 1: seating under displacement control
-    out.write("*STEP, INC=200\n" + _static(0.5, 1.0, 1e-4, 0.5))
+    out.write("*STEP, INC=200\n" + static_step(0.5, 1.0, 1e-4, 0.5))
     _change_friction(out, mesh, lower, upper, contact, loading=True)
-    out.write(f"*BOUNDARY\n{ref}, 1, 1, 0.\n{ref}, 2, 2, {_fmt(-seat)}\n")
-    _outputs(out, plastic, fine_stress, frd, "", stress_sets)
+    out.write(f"*BOUNDARY\n{ref}, 1, 1, 0.\n{ref}, 2, 2, {fmt(-seat)}\n")
+    outputs("")
     out.write("*END STEP\n")
     # step 2: normal load P on REF (automatic increments <= 1 / n_load, output at 1 / n_load)
     refine = max(int(case.refine), 1)
     dt = 1.0 / (n_load * refine)
-    out.write("*STEP, INC=1000\n" + _static(dt, 1.0, dt * 1e-4, dt))
+    out.write("*STEP, INC=1000\n" + static_step(dt, 1.0, dt * 1e-4, dt))
     out.write(f"*BOUNDARY, OP=NEW\nLBOT, 1, 2\n{ref}, 1, 1, 0.\n")
-    out.write(f"*CLOAD\n{ref}, 2, {_fmt(-case.load)}\n" + controls)
-    _outputs(out, plastic, fine_stress, frd, "TLOAD", stress_sets)
+    out.write(f"*CLOAD\n{ref}, 2, {fmt(-case.load)}\n" + controls)
+    outputs("TLOAD")
     out.write("*END STEP\n")
-    # step 3: tangential displacement cycle (increments <= 4 / n, output every 4 / n)
-    if case.delta > 0 and case.split_cycle:
+    if case.delta > 0:
+        _cycle_steps(out, case, ref, controls, 2.0 * a * a / radius, outputs, sliding_friction)
+    path = Path(path)
+    path.write_text(out.getvalue())
+    return path
+
+
+def _cycle_steps(out: io.StringIO, case: LoadCase, ref: int, controls: str, lift: float,
+                 outputs: Callable[[str], None], sliding_friction: Callable[[], None]) -> None:
+    """The deck's tangential steps (step 3 on): REF's x displacement cycle, increments <=
+    4 / n (refined), outputs every 4 / n; with ``case.split_cycle`` one step per quarter of
+    each of ``case.cycles`` cycles and, with ``case.unload``, REF lifted by ``lift`` (m, where
+    the surfaces have separated) and the load removed; else one ``STROKE`` step."""
+    n = int(case.n_increments)
+    n_load = max(int(case.load_increments), 1)
+    refine = max(int(case.refine), 1)
+    if case.split_cycle:
         if int(case.cycles) != case.cycles or case.cycles < 1:
             raise ValueError(f"cycles = {case.cycles!r} is not allowed: an integer >= 1")
         targets = ([case.delta, 0.0, -case.delta, 0.0] * int(case.cycles))[
             :1 if case.half_cycle else None]
         dt = 4.0 / (n * refine * max(int(case.cycle_refine), 1))
         for k, target in enumerate(targets):
-            out.write("*STEP, INC=10000\n" + _static(dt, 1.0, dt * 1e-4, dt))
+            out.write("*STEP, INC=10000\n" + static_step(dt, 1.0, dt * 1e-4, dt))
             if k == 0:
-                _change_friction(out, mesh, lower, upper, contact, loading=False)
-            out.write(f"*BOUNDARY\n{ref}, 1, 1, {_fmt(target)}\n" + controls)
-            _outputs(out, plastic, fine_stress, frd, "TQUARTER", stress_sets)
+                sliding_friction()
+            out.write(f"*BOUNDARY\n{ref}, 1, 1, {fmt(target)}\n" + controls)
+            outputs("TQUARTER")
             out.write("*END STEP\n")
         if case.unload:  # REF to a height where the surfaces have separated, load removed
-            lift = 2.0 * a * a / radius
             dt = 1.0 / (n_load * refine)
-            out.write("*STEP, INC=1000\n" + _static(dt, 1.0, dt * 1e-4, dt))
+            out.write("*STEP, INC=1000\n" + static_step(dt, 1.0, dt * 1e-4, dt))
             out.write(f"*BOUNDARY, OP=NEW\nLBOT, 1, 2\n{ref}, 1, 1, 0.\n"
-                      f"{ref}, 2, 2, {_fmt(lift)}\n*CLOAD, OP=NEW\n{ref}, 2, 0.\n")
-            _outputs(out, plastic, fine_stress, frd, "TLOAD", stress_sets)
+                      f"{ref}, 2, 2, {fmt(lift)}\n*CLOAD, OP=NEW\n{ref}, 2, 0.\n")
+            outputs("TLOAD")
             out.write("*END STEP\n")
-    elif case.delta > 0:
-        dt = 4.0 / (n * refine)
-        out.write("*STEP, INC=10000\n" + _static(dt, total, dt * 1e-4, dt))
-        _change_friction(out, mesh, lower, upper, contact, loading=False)
-        out.write(f"*BOUNDARY, AMPLITUDE=STROKE\n{ref}, 1, 1, {_fmt(case.delta)}\n" + controls)
-        _outputs(out, plastic, fine_stress, frd, "TCYCLE", stress_sets)
-        out.write("*END STEP\n")
-    path = Path(path)
-    path.write_text(out.getvalue())
-    return path
+        return
+    dt = 4.0 / (n * refine)
+    total = 1.0 if case.half_cycle else 4.0
+    out.write("*STEP, INC=10000\n" + static_step(dt, total, dt * 1e-4, dt))
+    sliding_friction()
+    out.write(f"*BOUNDARY, AMPLITUDE=STROKE\n{ref}, 1, 1, {fmt(case.delta)}\n" + controls)
+    outputs("TCYCLE")
+    out.write("*END STEP\n")

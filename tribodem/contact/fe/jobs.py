@@ -17,12 +17,12 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 from numpy.typing import NDArray
 
-from tribodem.contact.base import ElasticBody, IncrementResult, Unsupported, _check_positive
+from tribodem.contact.base import ElasticBody, IncrementResult, Unsupported
 from tribodem.contact.elastoplastic import PlasticStep
 from tribodem.contact.fe.ccx import (
     CcxConvergenceError,
@@ -32,7 +32,7 @@ from tribodem.contact.fe.ccx import (
     resolve_ccx,
     run_ccx,
 )
-from tribodem.contact.fe.deck import ContactSettings, FEMaterial
+from tribodem.contact.fe.deck import ContactSettings
 from tribodem.io.results import write_csv, write_text
 
 
@@ -64,7 +64,7 @@ JOB_COLUMNS = ("cycle", "cycles", "elements", "refine", "penalty_scale", "second
 
 
 def prior_job_rows(path: Path) -> list[list[str]]:
-    """The rows of an earlier session's ``jobs.csv`` in ``JOB_COLUMNS`` order (a file
+    """The rows of an interrupted run's ``jobs.csv`` in ``JOB_COLUMNS`` order (a file
     written before a column existed gets ``JOB_DEFAULTS``); ``[]`` when there is no such
     file or its header has a column this version does not know."""
     if not path.exists():
@@ -263,11 +263,13 @@ def check_stress_depth(depth: float, printed: float, backend: str) -> None:
 
 
 class CcxJobs:
-    """Mixin of the ccx-per-cycle backends: the work folder, the jobs' records and profile,
-    and serving a cycle's increments. The backend sets ``name``, ``workdir``, ``jobs``,
-    ``_cycle``, ``_k``, ``_served``, ``offsets``, ``amplitude`` and ``n_increments``."""
+    """Mixin of the ccx-per-cycle backends: the work folder, running a job's attempts, the
+    jobs' records and profile, and serving a cycle's increments. The backend
+    (:class:`~tribodem.contact.fe.base.CcxBackend`) sets ``name``, ``workdir``, ``jobs``,
+    ``_cycle``, ``_k``, ``_served``, ``offsets``, ``amplitude``, ``n_increments`` and the
+    attributes declared below."""
 
-    name: str
+    name: ClassVar[str]
     workdir: Path | None
     jobs: list[JobRecord]
     offsets: NDArray[np.float64]
@@ -289,7 +291,7 @@ class CcxJobs:
     retries: int
     threads: int
     timeout: float
-    executable: str | None
+    executable: str  #: the ccx executable (:func:`~tribodem.contact.fe.ccx.find_ccx`)
     cache: Path | None
     #: where a job's attempts start (:data:`RETRY_FROM`)
     retry_from: str = "first"
@@ -300,28 +302,6 @@ class CcxJobs:
     #: the attempt on which the last job converged (:func:`attempt_index`; kept in the
     #: backend's state, so a resumed run starts where the uninterrupted one would)
     _last_attempt: int = 0
-
-    def _set_retry_from(self, retry_from: str) -> None:
-        """Check and keep ``retry_from`` (:data:`RETRY_FROM`)."""
-        if retry_from not in RETRY_FROM:
-            raise ValueError(f"retry_from = {retry_from!r} is not allowed: allowed: "
-                             f"{', '.join(RETRY_FROM)}")
-        self.retry_from = retry_from
-
-    def _set_loading_friction(self, loading_friction: str) -> None:
-        """Check ``loading_friction`` (:data:`LOADING_FRICTION`) and set the seating and
-        loading friction of ``settings`` from it (call after ``settings``, ``friction`` and
-        the material are set; ``full`` with mu = 0 keeps the low value: ccx refuses a zero
-        coefficient)."""
-        if loading_friction not in LOADING_FRICTION:
-            raise ValueError(f"loading_friction = {loading_friction!r} is not allowed: "
-                             f"allowed: {', '.join(LOADING_FRICTION)}")
-        if loading_friction == "auto":
-            loading_friction = "full" if self.plastic else "low"
-        self.loading_friction = loading_friction
-        if loading_friction == "full":
-            self.settings = replace(self.settings,
-                                    mu_loading=max(self.friction, self.settings.mu_loading))
 
     def _first_attempt(self) -> int:
         """The attempt the next job starts at (:data:`RETRY_FROM`)."""
@@ -379,55 +359,14 @@ class CcxJobs:
         return self._scaled_settings(self._penalty_scale).stick_slope(
             self.upper_material.young, self.lower_material.young, self.mesh.h_fine)
 
-    def _set_material(self, material: str, plastic_increments: int, yield_strength: float,
-                      uts: float, uts_strain: float, hardening: float | None,
-                      beyond_uts: str) -> None:
-        """Check and keep the bodies' material (:data:`MATERIALS`) and plastic law (Pa, Pa,
-        -, Pa, and past the UTS :data:`~tribodem.contact.fe.deck.BEYOND_UTS`;
-        ``ValueError`` on an impossible one) and the fewest ccx increments per plastic
-        cycle."""
-        if material not in MATERIALS:
-            raise ValueError(f"material = {material!r} is not allowed: allowed: "
-                             f"{', '.join(MATERIALS)}")
-        self.material = material
-        self.plastic = material == "elastic-plastic"
-        self.plastic_increments = checked_increments("plastic_increments", plastic_increments)
-        self.plastic_law = FEMaterial(
-            yield_strength=_check_positive("yield_strength", yield_strength),
-            uts=_check_positive("uts", uts), uts_strain=_check_positive("uts_strain", uts_strain),
-            hardening=hardening, beyond_uts=beyond_uts)
-        if self.plastic:
-            self.plastic_law.plastic_table()  # ValueError on an impossible law
-
-    def _law_report(self) -> dict[str, Any] | None:
-        """For summary.json: the plastic law the jobs ran (None for elastic bodies): Y,
-        the plastic modulus h (Pa), what happens past the UTS and ccx's ``*PLASTIC`` rows
-        (true stress Pa, equivalent plastic strain; held after the last)."""
-        if not self.plastic:
-            return None
-        rows = self.plastic_law.plastic_table()
-        (y, _), (s1, p1) = rows[0], rows[-1]
-        return {"yield_strength_pa": y, "hardening_pa": (s1 - y) / p1 if p1 > 0 else 0.0,
-                "beyond_uts": self.plastic_law.beyond_uts,
-                "plastic_table": [[s, e] for s, e in rows]}
-
-    def _materials(self) -> tuple[FEMaterial, FEMaterial]:
-        """The (lower, upper) ccx materials: elastic constants, with the plastic law."""
-        lo, up = self.lower_material, self.upper_material
-        law = self.plastic_law
-        y = law.yield_strength if self.plastic else None
-        return tuple(FEMaterial(b.young, b.poisson, yield_strength=y, uts=law.uts,  # type: ignore[return-value]
-                                uts_strain=law.uts_strain, hardening=law.hardening,
-                                beyond_uts=law.beyond_uts)
-                     for b in (lo, up))
-
     def _plastic_grid_x(self, body: str) -> NDArray[np.float64]:
         """x of the plastic-step grid: the window (upper, its own frame) or the window plus
         the stroke (lower, lab frame) at the window spacing, m."""
         if body == "upper":
             return self.coords
         pad = math.ceil(self.amplitude / self.dx) + 1
-        return (np.arange(-pad, self.n + pad) - self.n // 2) * self.dx
+        return ((np.arange(-pad, self.n + pad) - self.n // 2) * self.dx).astype(np.float64,
+                                                                                 copy=False)
 
     def plastic_steps(self) -> list[PlasticStep]:
         """The plastic steps solved since the last call (then forgotten): the loading (a
@@ -505,18 +444,19 @@ class CcxJobs:
         return inc
 
     def _write_profile(self) -> None:
-        """``workdir/jobs.csv``: one row per job (with the rows of an earlier session of a
-        resumed run), rewritten atomically whenever a job is run or its fields are mapped."""
+        """``workdir/jobs.csv``: one row per job (a resumed run's after the rows written
+        before it stopped), rewritten atomically whenever a job is run or its fields are mapped."""
         assert self.workdir is not None
         path = self.workdir / "jobs.csv"
         if self._prior_jobs is None:
             self._prior_jobs = prior_job_rows(path)
-        rows = [[rec.cycle, rec.cycles, rec.elements, rec.refine, f"{rec.penalty_scale:g}",
-                 f"{rec.seconds_mesh:.4f}",
-                 f"{rec.seconds_ccx:.3f}", f"{rec.seconds_read:.4f}", f"{rec.seconds_map:.4f}",
-                 f"{rec.worn_volume_upper:.9e}", f"{rec.worn_volume_lower:.9e}",
-                 int(rec.cached), str(rec.deck)]
-                for rec in self.jobs]
+        rows: list[list[Any]] = [
+            [rec.cycle, rec.cycles, rec.elements, rec.refine, f"{rec.penalty_scale:g}",
+             f"{rec.seconds_mesh:.4f}",
+             f"{rec.seconds_ccx:.3f}", f"{rec.seconds_read:.4f}", f"{rec.seconds_map:.4f}",
+             f"{rec.worn_volume_upper:.9e}", f"{rec.worn_volume_lower:.9e}",
+             int(rec.cached), str(rec.deck)]
+            for rec in self.jobs]
         write_csv(path, JOB_COLUMNS, self._prior_jobs + rows)
 
     def profile(self) -> dict[str, float]:

@@ -22,11 +22,15 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
 
 from tribodem.contact.base import Recession
+
+if TYPE_CHECKING:
+    import meshio
 
 #: ccx face label of each quadrilateral edge (nodes 1-2, 2-3, 3-4, 4-1 counter-clockwise)
 FACES = ("S1", "S2", "S3", "S4")
@@ -102,7 +106,7 @@ class Mesh:
         if bad.size:
             raise ValueError(f"{bad.size} elements with non-positive area (first: {bad[0] + 1})")
 
-    def to_meshio(self) -> object:
+    def to_meshio(self) -> meshio.Mesh:
         """A :class:`meshio.Mesh` (z = 0) with a ``body`` cell field (0 lower, 1 upper)."""
         import meshio
 
@@ -114,7 +118,7 @@ class Mesh:
     def write_vtk(self, path: str | Path) -> Path:
         """Write the mesh to a VTK/VTU file (format from the suffix, via meshio)."""
         path = Path(path)
-        self.to_meshio().write(path)  # type: ignore[attr-defined]
+        self.to_meshio().write(path)
         return path
 
 

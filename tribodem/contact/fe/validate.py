@@ -32,10 +32,14 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import brentq
 
+from tribodem.contact.base import ContactCase, ElasticBody
 from tribodem.contact.checks import check
 from tribodem.contact.fe.deck import FEMaterial, sliding_contact
 from tribodem.contact.fe.model import LineCase, LineRun, run_line_case
+from tribodem.contact.fe.options import FEOptions
 from tribodem.contact.fe.results import ContactState, ip_coordinates
+from tribodem.contact.geometry import cylinder, flat
+from tribodem.materials.en24t import EN24T
 
 #: Johnson's von Mises first-yield factor of a line contact (nu = 0.3) and its depth / a
 YIELD_FACTOR, YIELD_DEPTH = 1.79, 0.70
@@ -159,10 +163,11 @@ def tangential_checks(run: LineRun, ratios: tuple[float, ...] = (0.35, 0.55, 0.7
 def plastic_onset_case(h_over_a: float | None = None) -> LineCase:
     """EN24T with bilinear hardening (Y 680 MPa) loaded to 1.15 x Johnson's first-yield load
     P_y = pi R (1.79 Y)^2 / E* in 20 increments, no tangential step."""
-    mat = FEMaterial(yield_strength=680e6)
+    y = EN24T.yield_strength
+    mat = FEMaterial(yield_strength=y)
     kw: dict[str, Any] = {} if h_over_a is None else {"h_over_a": h_over_a}
     probe = LineCase(lower=mat, upper=mat, **kw)
-    p_y = math.pi * probe.radius * (YIELD_FACTOR * 680e6) ** 2 / probe.e_star
+    p_y = math.pi * probe.radius * (YIELD_FACTOR * y) ** 2 / probe.e_star
     return dataclasses.replace(probe, load=1.15 * p_y, load_increments=20)
 
 
@@ -212,8 +217,11 @@ def reversal_checks(folder: str | Path, threads: int = 1, timeout: float = 900.0
     case = default_case()
     p0, a = case.hertz
     window = 10.0 * a
-    s = FEContactSolver(load=case.load * window, window=window, n=64, amplitude=2.0 * a,
-                        n_increments=16, h_over_a=0.5, threads=threads, timeout=timeout,
+    pad = ContactCase(upper=cylinder(2.0 * case.radius, axis="y"), lower=flat(),
+                      upper_material=ElasticBody(), lower_material=ElasticBody(),
+                      load=case.load * window, friction=0.6, amplitude=2.0 * a,
+                      n_increments=16, n=64, window=window, contact="line")
+    s = FEContactSolver(pad, FEOptions(h_over_a=0.5, threads=threads, timeout=timeout),
                         workdir=Path(folder) / "reversal")
     s.reset()
     s.solve_increment(0.0)

@@ -1,0 +1,290 @@
+"""The braking run's configuration: the TOML tables as pydantic models (:class:`BrakingConfig`),
+the ``--quick`` preset (:meth:`BrakingConfig.quick`), the resolution (defaults <- the config
+<- the quick preset <- the condition, :func:`resolve_config` on
+:func:`tribodem.io.record.resolve`), the :class:`~tribodem.braking.setup.RunSetup` a config
+means (:func:`setup_from_config`) and the fields a resumed run may change
+(:data:`RESUME_FREE`).
+
+The resolved config is written to ``<out>/config.toml`` and reloads to the same config; a
+resume compares the config it is given with the checkpoint's field by field
+(:func:`check_same_config`).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any, Literal
+
+from pydantic import BaseModel, Field, model_validator
+
+from tribodem.braking.conditions import get_condition, load_to_pressure, rpm_to_speed
+from tribodem.braking.model import Geometry, materials
+from tribodem.braking.setup import RunSetup
+from tribodem.dem.thermal import read_curve
+from tribodem.io.config import ConfigError, validate
+from tribodem.io.model import StrictModel
+from tribodem.io.record import ConfigSource, Source, config_diffs, may_change_text, read_source
+from tribodem.io.record import resolve as resolve_model
+
+
+class ConditionCfg(StrictModel):
+    """Table 4 ``index`` or an explicit load (kN or Pa) and speed (r/min or m/s)."""
+
+    index: int | None = Field(None, ge=1, le=5, description="table 4 condition 1..5")
+    load_kN: float | None = Field(None, gt=0)
+    pressure_Pa: float | None = Field(None, gt=0)
+    rpm: float | None = Field(None, gt=0)
+    speed_m_s: float | None = Field(None, gt=0)
+
+    @model_validator(mode="after")
+    def _one_form(self) -> ConditionCfg:
+        if self.load_kN is not None and self.pressure_Pa is not None:
+            raise ValueError("give load_kN or pressure_Pa, not both")
+        if self.rpm is not None and self.speed_m_s is not None:
+            raise ValueError("give rpm or speed_m_s, not both")
+        return self
+
+
+class GeometryCfg(StrictModel):
+    """Interface cell sizes (m)."""
+
+    width_m: float = Field(216e-6, gt=0)
+    disc_height_m: float = Field(72e-6, gt=0)
+    pad_height_m: float = Field(108e-6, gt=0)
+    roughness_amplitude_m: float = Field(8e-6, ge=0)
+    roughness_modes: int = Field(4, ge=1, le=64)
+    roughness_first_mode: int = Field(
+        1, ge=1, le=64, description="lowest sine mode k (wavelength width/k); in a cell n "
+        "times the default width, n keeps the default cell's wavelengths and asperities")
+    clearance_m: float = Field(5e-8, ge=0)
+    seed: int = Field(0, ge=0)
+
+
+class RunCfg(StrictModel):
+    """Simulated sliding time (s), sampling, numerics."""
+
+    duration_s: float = Field(40e-6, gt=0, le=1e-2)
+    distance_m: float = Field(
+        0.0, ge=0, le=0.1,
+        description="slide this distance (m) instead of duration_s: duration = distance / "
+                    "sliding speed, so the conditions of a sweep are compared at the same "
+                    "distance (the closed cell's saturated wear depth, docs/braking.md); 0 = "
+                    "off; not with duration_s in the same file")
+    samples: int = Field(150, ge=2, le=100_000)
+    vtk_snapshots: int = Field(6, ge=0, le=10_000)
+    micro: Literal["calibrated", "table3"] = "calibrated"
+    plate_areal_mass_kg_m2: float = Field(
+        0.0, ge=0, le=1e4,
+        description="pressure plate mass per area (kg/m^2), e.g. 126 for the omitted pad "
+                    "and back plate; 0 = wall_mass_ratio x the cell's pad mass")
+    wall_mass_ratio: float = Field(0.05, gt=0, le=1000)
+    backing: Literal["absorbing", "support"] = "absorbing"
+    local_damping: float = Field(0.0, ge=0, lt=1)
+    dt_safety: float = Field(0.3, gt=0, le=1)
+    threads: int = Field(0, ge=0, le=256, description="0 = all cores")
+    figures: bool = True
+    until_steady: bool = Field(
+        False, description="slide past duration_s until the wear rate per sliding distance "
+                           "is steady (last third within steady_tolerance of the middle "
+                           "third), in blocks of 20% of duration_s, at most max_distance_m")
+    max_distance_m: float = Field(0.0, ge=0, le=1.0,
+                                  description="cap on the sliding distance (m) with "
+                                              "until_steady; 0 = 5 x speed x duration_s")
+    steady_tolerance: float = Field(0.15, gt=0, le=1)
+    ramp_s: float = Field(0.0, ge=0, le=1e-2,
+                          description="load ramped linearly from 0 over this sliding time "
+                                      "(s); 0 = the full load at once")
+    speed_ramp_s: float = Field(0.0, ge=0, le=1e-2,
+                                description="the disc starts at rest under the loaded pad "
+                                            "and reaches the speed linearly over this "
+                                            "time (s); 0 = at speed from the start")
+    outlet_length_m: float = Field(
+        0.0, ge=0, le=0.1,
+        description="debris outlet: a debris component leaves the cell once carried this "
+                    "far (m) along the sliding relative to the pad (residence length, e.g. "
+                    "a pad plateau, 50-500 um); 0 = closed cell, as in seed 000")
+    worn_through_diameters: float = Field(
+        2.0, ge=0, le=1000,
+        description="stop the run (exit 3, outputs kept) when a body's remaining intact "
+                    "thickness outside its anchored layer falls below this many of its "
+                    "mean particle diameters (worn through: the boundary layer meets the "
+                    "interface); 0 = never stop")
+    feed: bool = Field(
+        False, description="add a slab of fresh body behind a body's anchored layer "
+                           "whenever one slab's thickness has been worn (3 mean particle "
+                           "diameters), so slides can be longer than the bodies are thick "
+                           "(with outlet_length_m); the bodies are then cut from a block "
+                           "periodic in y (docs/braking.md 'Feed')")
+    checkpoint_every: int = Field(
+        0, ge=0, le=100_000,
+        description="samples between checkpoints (checkpoint.npz in the output folder); "
+                    "0 = ceil(samples / 10), about every 10% of the run")
+
+
+class ThermalCfg(StrictModel):
+    """Optional temperature boundary curve (CSV: time s, temperature K)."""
+
+    curve: str | None = None
+    time_map: Literal["simulated", "stretched"] = "simulated"
+
+
+class BrakingConfig(StrictModel):
+    """``tribodem braking run`` configuration (TOML tables)."""
+
+    condition: ConditionCfg = ConditionCfg()
+    geometry: GeometryCfg = GeometryCfg()
+    run: RunCfg = RunCfg()
+    thermal: ThermalCfg = ThermalCfg()
+
+    @classmethod
+    def quick(cls) -> dict[str, Any]:
+        """The ``--quick`` preset (a dict shaped like the TOML file, laid over the config):
+        a narrower cell (144 um) and a thinner disc (50 um) than the defaults, 20 us of
+        sliding. Its pad has the default height: a 50-um pad shattered under the first
+        impacts at conditions 1-4 (worn through within 0.06-0.55 mm, docs/braking.md
+        "Bodies worn through")."""
+        return {
+            "geometry": {"width_m": 144e-6, "disc_height_m": 50e-6, "pad_height_m": 108e-6,
+                         "roughness_amplitude_m": 6e-6, "roughness_modes": 3},
+            "run": {"duration_s": 20e-6, "distance_m": 0.0, "samples": 100,
+                    "vtk_snapshots": 4},
+        }
+
+
+#: config fields a resumed run may change (they do not change the results)
+RESUME_FREE = ("run.threads", "run.checkpoint_every", "run.figures")
+
+
+def _check_one_length(src: Source) -> None:
+    """``ConfigError`` when the config gives both run lengths, ``run.duration_s`` and a
+    non-zero ``run.distance_m``."""
+    run = src.data.get("run", {}) if isinstance(src.data.get("run"), dict) else {}
+    if "duration_s" in run and run.get("distance_m"):
+        raise ConfigError(f"{src.name}: field 'run.duration_s' = {run['duration_s']!r} and "
+                          f"'run.distance_m' = {run['distance_m']!r}: give one run length "
+                          "(distance_m replaces duration_s)")
+
+
+def resolve_config(config: ConfigSource | Source = None, *, condition: int | None = None,
+                   quick: bool = False) -> BrakingConfig:
+    """The run's config: defaults <- ``config`` (a :class:`BrakingConfig`, a dict shaped
+    like the TOML file, the path of a TOML file, or None) <- the quick preset (``quick``)
+    <- ``condition`` (table 4 index). A :class:`~tribodem.io.record.Source` is a run's
+    recorded config (its ``config.toml`` or its checkpoint's), taken as it is. A file or
+    a dict may give one run length only (``duration_s`` or ``distance_m``). ``ConfigError``
+    names every bad field."""
+    if isinstance(config, Source):
+        src = config
+    else:
+        src = read_source(config)
+        if not isinstance(config, BaseModel):
+            _check_one_length(src)
+        if config is None:
+            src = Source({}, "braking")
+    return resolve_model(BrakingConfig, src.data, source=src.name,
+                         quick=BrakingConfig.quick() if quick else None,
+                         overrides=None if condition is None else
+                         {"condition": {"index": condition}})
+
+
+def _pressure_speed(c: ConditionCfg) -> tuple[float, float]:
+    """(pressure Pa, sliding speed m/s) of the [condition] table; ``ConfigError`` when the
+    load or the speed is missing."""
+    base = get_condition(c.index) if c.index is not None else None
+    if c.pressure_Pa is not None:
+        p = c.pressure_Pa
+    elif c.load_kN is not None:
+        p = load_to_pressure(c.load_kN)
+    elif base is not None:
+        p = base.pressure_Pa
+    else:
+        raise ConfigError("braking: no load: give --condition 1..5 or [condition] index, "
+                          "load_kN or pressure_Pa")
+    if c.speed_m_s is not None:
+        v = c.speed_m_s
+    elif c.rpm is not None:
+        v = rpm_to_speed(c.rpm)
+    elif base is not None:
+        v = base.speed_m_s
+    else:
+        raise ConfigError("braking: no speed: give --condition 1..5 or [condition] index, "
+                          "rpm or speed_m_s")
+    return p, v
+
+
+def _geometry(cfg: BrakingConfig) -> Geometry:
+    """The cell's :class:`Geometry` (m); ``ConfigError`` when it cannot hold the bodies'
+    grains."""
+    g = cfg.geometry
+    geo = Geometry(width=g.width_m, disc_height=g.disc_height_m, pad_height=g.pad_height_m,
+                   amplitude=g.roughness_amplitude_m, modes=g.roughness_modes,
+                   first_mode=g.roughness_first_mode, clearance=g.clearance_m, seed=g.seed)
+    rmax = max(m.radius_range[1] for m in materials(cfg.run.micro))
+    try:
+        geo.check(rmax)
+    except ValueError as err:
+        raise ConfigError(f"braking: {err}") from None
+    return geo
+
+
+def setup_from_config(cfg: BrakingConfig) -> RunSetup:
+    """A ``RunSetup`` from a validated config; ``ConfigError`` when the load or speed is
+    missing, the cell too small, the thermal curve missing, or the feed asked for with a
+    thermal curve."""
+    c = cfg.condition
+    p, v = _pressure_speed(c)
+    explicit = any(x is not None for x in (c.load_kN, c.pressure_Pa, c.rpm, c.speed_m_s))
+    geo = _geometry(cfg)
+    curve = None
+    if cfg.thermal.curve is not None:
+        curve = Path(cfg.thermal.curve)
+        if not curve.is_file():
+            raise ConfigError(f"braking: thermal.curve = '{curve}': file does not exist")
+        try:  # read here, before any output is touched: a bad file changes nothing
+            read_curve(curve)
+        except ValueError as err:
+            raise ConfigError(f"braking: thermal.curve = '{curve}': {err}") from None
+    r = cfg.run
+    if r.feed and curve is not None:
+        raise ConfigError(f"braking: run.feed = true with thermal.curve = '{curve}': the "
+                          "feed does not carry temperatures; allowed: one of the two")
+    duration = r.distance_m / v if r.distance_m else r.duration_s
+    return RunSetup(pressure_Pa=p, speed_m_s=v, duration_s=duration, geometry=geo,
+                    condition=None if explicit else c.index, micro=r.micro, samples=r.samples,
+                    vtk_snapshots=r.vtk_snapshots, wall_mass_ratio=r.wall_mass_ratio,
+                    plate_areal_mass=r.plate_areal_mass_kg_m2 or None, backing=r.backing,
+                    local_damping=r.local_damping, dt_safety=r.dt_safety,
+                    thermal_curve=curve, thermal_time_map=cfg.thermal.time_map,
+                    figures=r.figures, checkpoint_every=r.checkpoint_every,
+                    until_steady=r.until_steady, max_distance_m=r.max_distance_m,
+                    steady_tolerance=r.steady_tolerance, ramp_s=r.ramp_s,
+                    speed_ramp_s=r.speed_ramp_s, outlet_length_m=r.outlet_length_m,
+                    worn_through_diameters=r.worn_through_diameters, feed=r.feed)
+
+
+def config_differences(old: dict[str, Any], new: dict[str, Any]) -> list[tuple[str, Any, Any]]:
+    """(field, old, new) of the resolved configs that differ, ``RESUME_FREE`` left out."""
+    return config_diffs(old, new, RESUME_FREE)
+
+
+def checkpoint_config(rec: dict[str, Any], path: Path) -> dict[str, Any] | None:
+    """The resolved config a checkpoint's run was made with (``rec``: its braking-loop
+    record; None when it has none)."""
+    if rec.get("config") is None:
+        return None
+    return validate(BrakingConfig, rec["config"], source=f"checkpoint '{path}'").model_dump()
+
+
+def check_same_config(cfg: BrakingConfig, old: dict[str, Any] | None, path: Path) -> None:
+    """``ConfigError`` naming the first field (and how many more) in which ``cfg`` differs
+    from the checkpoint's config ``old`` (``path``: the checkpoint), ``RESUME_FREE``
+    aside; nothing when the checkpoint has no config."""
+    if old is None:
+        return
+    diff = config_differences(old, cfg.model_dump())
+    if diff:
+        name, a, b = diff[0]
+        more = f" (and {len(diff) - 1} more)" if len(diff) > 1 else ""
+        raise ConfigError(
+            f"--resume: {name} = {b!r} differs from the checkpointed run's {a!r}{more} "
+            f"('{path}'); allowed: the same value ({may_change_text(RESUME_FREE)})")
