@@ -1,4 +1,4 @@
-"""DE phase of the debris third body: N debris clumps loaded to equilibrium (issue 6).
+"""DE phase of the debris third body: N debris clumps loaded to equilibrium (docs/debris.md).
 
 The default case: crossed 8 mm cylinders at 100 N (window 128^2), a worn scar shaped like
 the contact pressure holding the volume of N particles of d = 0.6 um (equal thirds of the

@@ -5,7 +5,7 @@
  *
  * Tags a 2-thread benchmark run with where the hypervisor put the VM's two vCPUs: on a
  * 2-core AMD EPYC VM it reads 26-45 ns (one L3 cache) or 158-190 ns (two), and tribodem's
- * 2-thread settle3d runs ~20 % slower in the second state (BENCHMARKS.md, session 40).
+ * 2-thread settle3d runs ~20 % slower in the second state (BENCHMARKS.md, DEM engine).
  * Run it on an idle machine: a busy core makes the spinning thread wait for its turn. */
 #define _GNU_SOURCE
 #include <pthread.h>

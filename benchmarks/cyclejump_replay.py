@@ -1,4 +1,4 @@
-"""Cycle-jumping replay benchmark (issue 4): every strategy on two synthetic series.
+"""Cycle-jumping replay benchmark: every strategy on two synthetic series.
 
 Series (``tribodem.cyclejump.synthetic_two_phase_series``, 2000 cycles):
 * linear: constant wear per cycle, no noise;
@@ -10,7 +10,7 @@ of runs with a jump inside the running-in transition (true rate > 1.5x steady).
 
     .venv/bin/python benchmarks/cyclejump_replay.py [--seeds 10]
 
-``--smooth`` (issue 13, step control): every strategy on the smooth shapes of
+``--smooth`` (the step control): every strategy on the smooth shapes of
 ``tribodem.cyclejump.synthetic_smooth_series`` (linear, power law h ~ N^0.5, exponential
 run-in r_s + 9 r_s exp(-N / (n/10)), two-phase), 3000 cycles, without noise and with 2 %
 multiplicative noise (noise seeds 0..S-1). One Markdown row per strategy setting, one column
@@ -45,11 +45,12 @@ CONFIGS: list[tuple[str, str, dict]] = [
     ("cojocaru", "q_y 0.02, q_e 0.05 (sec 4.2.2)", {}),
     ("moving", "x 8, q_y 1, q_e 0.1 % (table 4.1)", {}),
     ("overlapping", "x 8, q_y 1, q_e 0.1 % (table 4.2)", {}),
-    ("adaptive", "defaults", {}),
-    ("adaptive", "cubic throughout (degree_late=none)", {"degree_late": None}),
-    ("adaptive", "fig 4.15 cap (max_jump_initial=15)", {"max_jump_initial": 15}),
-    ("adaptive", "taylor_order=2 (appendix III)", {"taylor_order": 2}),
-    ("adaptive", "degree=2", {"degree": 2}),
+    ("adaptive", "defaults (a fitted curve)", {}),
+    ("polynomial", "defaults", {}),
+    ("polynomial", "cubic throughout (degree_late=none)", {"degree_late": None}),
+    ("polynomial", "fig 4.15 cap (max_jump_initial=15)", {"max_jump_initial": 15}),
+    ("polynomial", "taylor_order=2 (appendix III)", {"taylor_order": 2}),
+    ("polynomial", "degree=2", {"degree": 2}),
 ]
 
 
@@ -65,10 +66,11 @@ SMOOTH_CONFIGS: list[tuple[str, str, dict]] = [
     ("overlapping", "defaults (tol = q_e/2 = 0.05 %)", {}),
     ("overlapping", "step_control=seed (eq 4.6 alone)", {"step_control": "seed"}),
     ("overlapping", "q_e = 2 % (tol 1 %)", {"q_e": 0.02}),
-    ("adaptive", "defaults (tol = q_e/2 = 1 %)", {}),
-    ("adaptive", "step_control=seed (before issue 13)", {"step_control": "seed"}),
+    ("adaptive", "defaults (a fitted curve, tol 1 %)", {}),
     ("adaptive", "tol 0.5 %", {"tol": 0.005}),
     ("adaptive", "tol 2 %", {"tol": 0.02}),
+    ("polynomial", "defaults (tol = q_e/2 = 1 %)", {}),
+    ("polynomial", "step_control=seed (the thesis' sections 4.3-4.4)", {"step_control": "seed"}),
 ]
 
 
@@ -103,7 +105,7 @@ def main() -> None:
     ap.add_argument("--cycles", type=int, default=None,
                     help="cycles per series (default 2000; 3000 with --smooth)")
     ap.add_argument("--smooth", action="store_true",
-                    help="the smooth-shape table of the step control (issue 13)")
+                    help="the smooth-shape table of the step control")
     args = ap.parse_args()
     if args.smooth:
         smooth_table(args.cycles or 3000, 5 if args.seeds is None else args.seeds)

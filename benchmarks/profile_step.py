@@ -1,4 +1,4 @@
-"""Where a DEM step's time goes, kernel by kernel (issue 16), on one thread.
+"""Where a DEM step's time goes, kernel by kernel, on one thread.
 
 Runs a benchmark case (``tribodem.dem.bench_cases``) with the compiled loop's own kernels
 called one at a time from Python in the loop's order (``engine._run_steps``: rebuild

@@ -3,14 +3,19 @@ Hertz sphere-on-flat contact in gross slip (q = mu p against the sliding directi
 
 It ignores wear (the surfaces it is given do not change its answer) and gives no subsurface
 stress: it declares so in its capabilities, and the loop must refuse a criterion that needs
-more. Registered by one line: ``BACKENDS["analytic-hertz"] = AnalyticHertzSolver``.
+more. Its one option, the sphere's radius, is its own ``[analytic]`` table
+(:class:`AnalyticOptions`, declared in :attr:`AnalyticHertzSolver.options`): a fretting
+config takes it as it takes the built-in backends' tables. Registered by one line:
+``BACKENDS["analytic-hertz"] = AnalyticHertzSolver``.
 """
 
 from __future__ import annotations
 
-from typing import Any
+from collections.abc import Mapping
+from typing import Any, ClassVar
 
 import numpy as np
+from pydantic import BaseModel, Field
 
 from tribodem.contact import (
     Capabilities,
@@ -21,6 +26,14 @@ from tribodem.contact import (
     contact_modulus,
     crossed_cylinders,
 )
+from tribodem.contact.base import ContactCase
+from tribodem.io.model import StrictModel
+
+
+class AnalyticOptions(StrictModel):
+    """``[analytic]``: the closed-form backend's own option."""
+
+    radius: float = Field(4e-3, gt=0, description="radius of the Hertz sphere, m")
 
 
 class AnalyticHertzSolver(FirstBodySolver):
@@ -28,6 +41,18 @@ class AnalyticHertzSolver(FirstBodySolver):
     window of ``window`` (m); gross slip with friction ``friction``."""
 
     capabilities = Capabilities(subsurface=False, contacts=("point",))
+    options: ClassVar[dict[str, type[BaseModel]]] = {"analytic": AnalyticOptions}
+
+    @classmethod
+    def from_case(cls, case: ContactCase, options: Mapping[str, BaseModel] | None = None
+                  ) -> AnalyticHertzSolver:
+        """On ``case`` with the ``[analytic]`` table's radius (its default when left
+        out)."""
+        opts = (options or {}).get("analytic") or AnalyticOptions()
+        assert isinstance(opts, AnalyticOptions)
+        return cls(case.upper, case.lower, load=case.load, friction=case.friction,
+                   upper_material=case.upper_material, lower_material=case.lower_material,
+                   n=case.n, window=case.window, radius=opts.radius)
 
     def __init__(self, upper: Any = None, lower: Any = None, load: float = 100.0,
                  friction: float = 0.6, upper_material: ElasticBody | None = None,

@@ -10,21 +10,22 @@ from tribodem.dem import Box, Material, ParticleState, Simulation
 STEEL = dict(young=2.1e11, poisson=0.3, density=7850.0)
 
 #: Worker-seconds of the longest test files, measured with CI's ccx (Debian's, SPOOLES) on a
-#: 2-core VM, numba's cache warm (BENCHMARKS.md "Session 38"; the two fe3d files "Session
-#: 39", after their compact bodies); only their order matters.
+#: 2-core VM, numba's cache warm; only their order matters.
 #: ``pytest -n auto --dist loadfile`` hands whole files to the workers, by default those with
 #: the most tests first, which put the three-test 4-min fe3d file last and left one worker
 #: alone with it for the last minutes. Longest first (files not listed after them, in
 #: collection order) gives a short makespan (Graham's LPT rule).
 FILE_SECONDS = {
     "test_fe_backend3d_runs.py": 147, "test_fe_backend3d.py": 118, "test_cli_errors.py": 89,
-    "test_braking.py": 67, "test_fe.py": 65, "test_fe_backend.py": 45,
+    "test_braking.py": 67, "test_fe.py": 65, "test_faults.py": 55, "test_fe_backend.py": 45,
     "test_fretting_resume.py": 43, "test_fretting_geometry.py": 38,
     "test_braking_dask.py": 36, "test_braking_resume.py": 33, "test_cli_resume.py": 28,
-    "test_fretting_jump.py": 25, "test_fretting_sweep.py": 24, "test_fe_plastic.py": 24,
-    "test_materials.py": 22, "test_fe_crossed.py": 18, "test_contact_halfspace.py": 17,
-    "test_cyclejump.py": 17, "test_fretting_debris_study.py": 17,
-    "test_fretting_study.py": 15, "test_cli.py": 15, "test_fretting.py": 13,
+    "test_fretting_line.py": 25, "test_fretting_jump.py": 25, "test_fretting_sweep.py": 24,
+    "test_fe_plastic.py": 24, "test_materials.py": 22, "test_config_properties.py": 20,
+    "test_fe_crossed.py": 18, "test_contact_halfspace.py": 17, "test_cyclejump.py": 17,
+    "test_fretting_debris_study.py": 17, "test_library_braking.py": 16,
+    "test_fretting_study.py": 15, "test_cli.py": 15, "test_library_fretting.py": 15,
+    "test_fretting_sampling.py": 15, "test_fretting.py": 13,
 }
 
 

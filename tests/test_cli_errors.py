@@ -230,7 +230,7 @@ def test_the_commands_modules_leave_scipys_heavy_subpackages_unimported() -> Non
     """A refusal (or ``--help``) costs the command's imports: every command's module loads
     without scipy's signal, optimize, interpolate, spatial, sparse or stats (0.2-0.6 s each
     to import; the functions that use them import them: 1.4 -> 0.6 s for a refused
-    ``fretting run``, BENCHMARKS.md "Session 38"), checked in a fresh interpreter."""
+    ``fretting run``), checked in a fresh interpreter."""
     import subprocess
     import sys
 

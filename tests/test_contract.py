@@ -35,6 +35,21 @@ def test_new_backend_runs_the_loop_from_a_config(registered) -> None:
     assert total == pytest.approx(ALPHA_SEED * hist.cumulative_energy, rel=1e-9)
 
 
+def test_new_backend_takes_its_own_options_table(registered) -> None:
+    """The plug-in backend's ``[analytic]`` table (its own options model) through the
+    config: validated by its model (a bad value refused naming ``analytic.radius``),
+    handed to the backend, recorded as a table of its own and read back."""
+    cfg = resolve_config(None, overrides={"solver": registered, "cycles": 1,
+                                          "contact": {"n": 64}, "analytic": {"radius": 6e-3}})
+    loop = build_loop(cfg)
+    assert loop.solver.hertz.radius == 6e-3
+    rec = cfg.record()
+    assert rec["analytic"] == {"radius": 6e-3}
+    assert resolve_config(None, base=rec) == cfg
+    with pytest.raises(ConfigError, match=r"analytic\.radius = -1"):
+        resolve_config(None, overrides={"solver": registered, "analytic": {"radius": -1}})
+
+
 def test_capabilities_refuse_a_criterion_before_any_work(registered) -> None:
     with pytest.raises(CriterionUnavailable, match="subsurface.*AnalyticHertzSolver"):
         FrettingLoop(AnalyticHertzSolver(), make_criterion("s22"))

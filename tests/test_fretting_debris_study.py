@@ -2,7 +2,8 @@
 
 Closed forms: the centre / edge zones and their mean pressures on a Hertz distribution;
 equilibrium (solid + debris force on the lower body = the applied load) and the imposed
-particle count in the run, through the installed command; resume reuses finished stages.
+particle count in the run, through the installed command; resume reuses finished stages,
+and a study killed between two counts resumes to the uninterrupted study, bitwise.
 """
 
 from __future__ import annotations
@@ -12,6 +13,7 @@ import math
 from pathlib import Path
 
 import numpy as np
+import pytest
 from conftest import run_tribodem
 
 from tribodem.fretting.debris import DebrisSettings
@@ -59,15 +61,26 @@ def test_placement_count_and_sites() -> None:
     assert ((i >= 20) & (i < 30) & (j >= 25) & (j < 40)).all()
 
 
-def test_debris_study_command(tmp_path: Path) -> None:
+#: the tiny study of these tests (its folder given with --out)
+STUDY = ["fretting", "debris-study", "--quick", "--cycle", "2", "--counts", "300,1200",
+         "--threads", "1", "--no-progress"]
+
+
+@pytest.fixture(scope="module")
+def study(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The folder of the tiny study, run once without interruption."""
+    out = tmp_path_factory.mktemp("debris_study") / "study"
+    r = run_tribodem(*STUDY, "--out", str(out))
+    assert r.returncode == 0, r.stdout + r.stderr
+    return out
+
+
+def test_debris_study_command(study: Path) -> None:
     """The whole study on a tiny case: imposed counts, servo at its target, equilibrium of
     the lower body within 1e-6 of the load, more debris carrying more load; --resume reuses
     every stage and rewrites the same table."""
-    out = tmp_path / "study"
-    args = ["fretting", "debris-study", "--quick", "--cycle", "2", "--counts", "300,1200",
-            "--threads", "1", "--no-progress", "--out", str(out)]
-    r = run_tribodem(*args)
-    assert r.returncode == 0, r.stdout + r.stderr
+    out = study
+    args = [*STUDY, "--out", str(out)]
     s = json.loads((out / "debris_study.json").read_text())
     assert s["cycle"] == 2 and [row["particles"] for row in s["rows"]] == [300, 1200]
     load = 100.0
@@ -91,3 +104,46 @@ def test_debris_study_command(tmp_path: Path) -> None:
     r3 = run_tribodem("fretting", "debris-study", "--out", str(out), "--resume", "--no-progress")
     assert r3.returncode == 0, r3.stdout + r3.stderr
     assert "DE phase" not in r3.stdout and (out / "debris_study.csv").read_text() == table
+
+
+def _numbers(row: dict) -> dict:
+    """A count's row without its wall-clock time."""
+    return {k: v for k, v in row.items() if k != "de_wall_time_s"}
+
+
+def test_a_study_killed_after_a_count_resumes_to_the_uninterrupted_study(
+        tmp_path: Path, study: Path) -> None:
+    """kill -9 once the first count is done, then --resume: the next count is bitwise the
+    uninterrupted study's (the first-body solver's warm starts after each count are in the
+    count's stage checkpoint; without them the next count's solves started from the
+    no-debris solution: peak pressure 2759442594 vs 2759462305 Pa)."""
+    import signal
+    import subprocess
+    import time
+
+    from conftest import tribodem_exe
+
+    out = tmp_path / "killed"
+    proc = subprocess.Popen([tribodem_exe(), *STUDY, "--out", str(out)],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    first = out / "count_000300.json"
+    end = time.monotonic() + 300
+    while not first.exists():
+        assert proc.poll() is None, proc.communicate()
+        assert time.monotonic() < end, "the first count did not finish"
+        time.sleep(0.01)
+    proc.send_signal(signal.SIGKILL)
+    proc.communicate(timeout=60)
+    assert not (out / "count_001200.json").exists(), "killed too late: the study finished"
+    r = run_tribodem(*STUDY, "--out", str(out), "--resume")
+    assert r.returncode == 0, r.stdout + r.stderr
+    assert "300 debris particles" not in r.stdout and "1,200 debris particles" in r.stdout
+    for count in (300, 1200):
+        a = json.loads((study / f"count_{count:06d}.json").read_text())
+        b = json.loads((out / f"count_{count:06d}.json").read_text())
+        assert _numbers(a) == _numbers(b), count
+        with np.load(study / f"count_{count:06d}.npz") as fa, \
+                np.load(out / f"count_{count:06d}.npz") as fb:
+            assert fa.files == fb.files
+            for k in fa.files:
+                assert np.array_equal(fa[k], fb[k]), (count, k)

@@ -42,9 +42,83 @@ LEGEND = (
     "\"the seed's\" means the source work's."
 )
 
-#: Units written as a suffix of a field's name (the braking tables).
+#: Units written as a suffix of a field's name (the braking tables), or as its name.
 NAME_UNITS = (("_kg_m2", "kg/m^2"), ("_m_s", "m/s"), ("_kN", "kN"), ("_MPa", "MPa"),
               ("_Pa", "Pa"), ("_m", "m"), ("_s", "s"))
+EXACT_UNITS = {"rpm": "r/min"}
+
+#: Descriptions of the keys whose model field has none yet (dotted key, as in the page):
+#: used only while the field's ``Field(description=...)`` is empty. Move them into the
+#: models; an entry whose field has a description in the code is not used.
+MISSING: dict[str, str] = {
+    # fretting
+    "cycles": "cycles to run, simulated and jumped (a resume may raise it)",
+    "contact.geometry": "the first-body case: crossed cylinders, sphere on flat, cylinder "
+    "on flat (line contact), flat punch with a rounded edge, measured height maps "
+    "(docs/fretting.md 'Geometries')",
+    "contact.regime": "tangential problem: gross, q = mu p wherever in contact; "
+    "ciavarella-jaeger, partial slip after the loading and each reversal (Mindlin's "
+    "superposition; point contacts on the elastic half-space)",
+    "wear.criterion": "material evolution criterion: energy (eq 2.7), archard (eq 2.6), "
+    "s22, von_mises, shear (eq 6.9), dfdi (eqs 6.1-6.2), swt (eqs 6.3-6.8)",
+    "jump.strategy": "cycle-jumping strategy (none: every cycle is simulated); its "
+    "parameters in jump.params",
+    "jump.params": "keyword parameters of the strategy (the table below); an unknown key "
+    "is refused",
+    "debris.cor": "coefficient of restitution of the debris contacts (Hertz-Mindlin)",
+    "debris.friction": "sliding friction coefficient of the debris contacts",
+    "debris.rolling_friction": "rolling friction coefficient of the debris contacts "
+    "(constant torque)",
+    "debris.seed": "random seed of the debris placement",
+    "output.figures": "write the PNG figures (profiles, wear scar, wear per cycle)",
+    "output.vtk": "write the worn surfaces for ParaView (surface_upper.vtu, "
+    "surface_lower.vtu)",
+    # braking
+    "condition.load_kN": "brake load, kN (table 4; turned into the pad pressure by the "
+    "pad area the table implies: 13 kN -> 0.33 MPa)",
+    "condition.pressure_Pa": "pressure on the pad, Pa (instead of load_kN)",
+    "condition.rpm": "disc speed, r/min (table 4; turned into the sliding speed at the "
+    "friction radius the table implies: 1200 r/min -> 47.12 m/s)",
+    "condition.speed_m_s": "sliding speed, m/s (instead of rpm)",
+    "geometry.width_m": "cell width along the sliding (periodic), m",
+    "geometry.disc_height_m": "disc (Q345B) height, m",
+    "geometry.pad_height_m": "pad (Cu-based powder metallurgy) height, m",
+    "geometry.roughness_amplitude_m": "largest height of the random sine profiles cut into "
+    "both surfaces, m",
+    "geometry.roughness_modes": "highest sine mode k of the surface profiles (wavelength "
+    "width / k)",
+    "geometry.clearance_m": "gap between the pad's lowest and the disc's highest point at "
+    "the start, m",
+    "geometry.seed": "packing and roughness seed (a sweep's packing k runs seed + k)",
+    "run.duration_s": "simulated sliding time, s (mapped to braking time by the identity, "
+    "stated in summary.json)",
+    "run.samples": "measurement samples over the run (rows of timeseries.csv)",
+    "run.vtk_snapshots": "VTK snapshots of the particles and force chains over the run "
+    "(0: none)",
+    "run.micro": "micro-parameters: calibrated, E_c and kratio of tribodem calibrate with "
+    "table 3's strengths; table3, the source work's table 3 as printed",
+    "run.wall_mass_ratio": "pressure plate mass / the cell's pad mass (when "
+    "plate_areal_mass_kg_m2 is 0)",
+    "run.backing": "the pad's back face: absorbing, non-reflecting dashpots standing for "
+    "the omitted pad; support, its top layer held in x and free in y",
+    "run.local_damping": "local (PFC) damping coefficient while sliding (0: none)",
+    "run.dt_safety": "time step / the critical time step",
+    "run.figures": "write the PNG figures",
+    "run.steady_tolerance": "until_steady: the last third's wear rate within this "
+    "fraction of the middle third's",
+    "thermal.curve": "temperature boundary curve: the path of a CSV file of time in s and "
+    "temperature in K, applied to every particle (left out: no thermal load)",
+    "thermal.time_map": "simulated, the curve's time is the simulated time; stretched, the "
+    "curve squeezed into the simulated window (an explicit distortion)",
+    # dem demo
+    "case.kind": "settle3d: Hertz-Mindlin spheres settling under gravity in an open box; "
+    "compress2d: linear-contact disks compressed by two platens",
+    "case.seed": "random seed of the particle placement",
+    "run.steps": "time steps to run (a resume may raise it)",
+    "output.scalars_every": "steps between rows of timeseries.csv",
+    "output.vtk_every": "steps between VTK snapshots (0: none)",
+    "output.checkpoint_every": "steps between checkpoints (0: none)",
+}
 
 #: Units recognised in a description, longest first: after ", " or "(" or at the start,
 #: followed by the end, a space, ",", ";" or ")".
@@ -72,6 +146,8 @@ def first_paragraph(text: str | None) -> str:
 
 def unit_of(name: str, description: str | None) -> str:
     """The field's unit: from its name's suffix, else from its description, else "-"."""
+    if name in EXACT_UNITS:
+        return EXACT_UNITS[name]
     for suffix, unit in NAME_UNITS:
         if name.endswith(suffix):
             return unit
@@ -86,7 +162,7 @@ def fmt_value(v: Any) -> str:
     if isinstance(v, bool):
         return f"`{str(v).lower()}`"
     if isinstance(v, float):
-        return f"`{v:.10g}`"
+        return f"`{fmt_number(v)}`"
     if isinstance(v, int):
         return f"`{v}`"
     if isinstance(v, str):
@@ -96,6 +172,15 @@ def fmt_value(v: Any) -> str:
     if isinstance(v, dict):
         return "`{}`" if not v else f"`{v}`"
     return f"`{v}`"
+
+
+def fmt_number(v: float) -> str:
+    """A float in 10 significant digits, large values with an exponent (6.8e+08)."""
+    text = f"{v:.10g}"
+    if "e" not in text and abs(v) >= 1e5:
+        mantissa, exp = f"{v:.10e}".split("e")
+        text = mantissa.rstrip("0").rstrip(".") + "e" + exp
+    return text
 
 
 def fmt_type(annotation: Any) -> str:
@@ -125,7 +210,7 @@ def fmt_range(metadata: list[Any]) -> str:
         for attr, sym in (("ge", ">="), ("gt", ">"), ("le", "<="), ("lt", "<")):
             v = getattr(m, attr, None)
             if v is not None:
-                out.append(f"{sym} {v:.10g}" if isinstance(v, float) else f"{sym} {v}")
+                out.append(f"{sym} {fmt_number(v)}" if isinstance(v, float) else f"{sym} {v}")
     return ", ".join(out) if out else "-"
 
 
@@ -141,24 +226,103 @@ def field_default(field: Any) -> Any:
     return field.default
 
 
+def filled_in(model: Any) -> dict[str, str]:
+    """Defaults a model fills in on validation, per field: the value in the default model,
+    else the values it takes for the values of the model's Literal fields ("`0.004` with
+    `geometry = "sphere_on_flat"` or ..."). A choice the model refuses on its own (a height
+    map without maps) is skipped."""
+    from pydantic import ValidationError
+
+    choices: list[tuple[str, Any]] = [("", None)]
+    for name, f in model.model_fields.items():
+        if typing.get_origin(f.annotation) is Literal:
+            choices += [(name, v) for v in typing.get_args(f.annotation)]
+    found: dict[str, dict[str, list[str]]] = {}
+    for name, value in choices:
+        try:
+            inst = model() if not name else model.model_validate({name: value})
+        except ValidationError:
+            continue
+        for fname, f in model.model_fields.items():
+            v = getattr(inst, fname)
+            if fname == name or is_model(f.annotation) or v == field_default(f):
+                continue
+            how = f"`{name} = {fmt_value(value).strip('`')}`" if name else ""
+            found.setdefault(fname, {}).setdefault(fmt_value(v), []).append(how)
+    out: dict[str, str] = {}
+    for fname, values in found.items():
+        out[fname] = "; ".join(v if "" in hows else f"{v} with " + " or ".join(hows)
+                               for v, hows in values.items())
+    return out
+
+
+def physical_of(field: Any) -> tuple[str, str]:
+    """(the field's physical range as text, its unit) when it declares one
+    (``tribodem.io.model.physical``: the range of real materials and rigs, refused outside
+    unless ``allow_unphysical = true``), else ("-", "")."""
+    from tribodem.io import model as m
+
+    if not hasattr(m, "physical_range"):
+        return "-", ""
+    rng = m.physical_range(field)
+    if rng is None:
+        return "-", ""
+    unit = m.physical_unit(field) if hasattr(m, "physical_unit") else ""
+    return m.range_text(rng[0], rng[1]), unit
+
+
+#: the sentence :func:`tribodem.io.model.physical` appends to a description (shown in the
+#: table's own column instead)
+_PHYSICAL_TEXT = re.compile(r"(?:^|;\s*)physical range [^()]*\([^)]*allow_unphysical[^)]*\)\s*$")
+
+
 def table_rows(model: Any, prefix: str) -> tuple[list[str], list[tuple[str, Any]]]:
     """The rows of ``model``'s own (non-table) fields, and its sub-tables (dotted name,
     model class)."""
     rows: list[str] = []
     tables: list[tuple[str, Any]] = []
+    filled = filled_in(model)
     for name, f in model.model_fields.items():
         key = f"{prefix}{name}"
         if is_model(f.annotation):
             tables.append((key, f.annotation))
             continue
-        default = field_default(f)
-        desc = clean(f.description)
-        rows.append(f"| `{key}` | {fmt_type(f.annotation)} | {fmt_value(default)} | "
-                    f"{fmt_range(f.metadata)} | {unit_of(name, f.description)} | {desc} |")
+        default = fmt_value(field_default(f))
+        if name in filled:
+            default += f"; filled in: {filled[name]}"
+        physical, physical_unit = physical_of(f)
+        description = f.description or ""
+        if physical != "-":
+            description = _PHYSICAL_TEXT.sub("", description).strip()
+        description = description or MISSING.get(key, "")
+        unit = physical_unit or unit_of(name, description)
+        rows.append(f"| `{key}` | {fmt_type(f.annotation)} | {default} | "
+                    f"{fmt_range(f.metadata)} | {physical} | {unit} | {clean(description)} |")
     return rows, tables
 
 
-HEADER = "| key | type | default | range | unit | description |\n|---|---|---|---|---|---|"
+def undescribed() -> list[str]:
+    """The dotted keys of every config model whose field has no description in the code."""
+    from tribodem.braking import BrakingConfig
+    from tribodem.dem import DemRunConfig
+    from tribodem.fretting import FrettingConfig
+
+    out: list[str] = []
+
+    def walk(model: Any, prefix: str) -> None:
+        for name, f in model.model_fields.items():
+            if is_model(f.annotation):
+                walk(f.annotation, f"{prefix}{name}.")
+            elif not f.description:
+                out.append(f"{prefix}{name}")
+
+    for m in (FrettingConfig, BrakingConfig, DemRunConfig):
+        walk(m, "")
+    return out
+
+
+HEADER = ("| key | type | default | allowed | physical range | unit | description |\n"
+          "|---|---|---|---|---|---|---|")
 
 
 def model_section(title: str, model: Any, intro: str, level: int = 2) -> list[str]:
@@ -206,7 +370,8 @@ def strategy_section() -> list[str]:
     for name, cls in STRATEGIES.items():
         params = [p for p in inspect.signature(cls.__init__).parameters.values()
                   if p.name != "self"]
-        text = ", ".join(f"`{p.name} = {fmt_value(p.default).strip('`')}`" for p in params)
+        text = ", ".join(f"`{p.name}` (unset)" if p.default is None else
+                         f"`{p.name} = {fmt_value(p.default).strip('`')}`" for p in params)
         out.append(f"| `{name}` | `{cls.__name__}` | {text} |")
     return out + [""]
 
@@ -218,8 +383,13 @@ def option_rows(command: Any) -> list[str]:
         if getattr(p, "hidden", False) or p.name == "help":
             continue
         names = " / ".join(f"`{o}`" for o in [*p.opts, *p.secondary_opts])
-        kind = "flag" if p.is_flag else p.bare_type().replace("Path", "path").replace(
-            "str", "text").replace("int", "integer").replace("float", "number")
+        base = p.bare_type()
+        if base.startswith("list[") and base.endswith("]"):
+            base = base[5:-1]
+        kind = "flag" if p.is_flag else {"Path": "path", "str": "text", "int": "integer",
+                                         "float": "number"}.get(base, base)
+        if getattr(p, "multiple", False):
+            kind += ", repeatable"
         if p.required:
             default = "required"
         elif p.is_flag and p.secondary_opts:
@@ -278,7 +448,10 @@ def config_page() -> str:
         "run `.venv/bin/python tools/config_reference.py` after changing a model. -->",
         "",
         "Every key of the TOML config files, with its type, default, allowed range, unit and "
-        "description. A dotted key `contact.load` is the key `load` of the table "
+        "description. *Allowed* is what the model accepts at all; *physical range* is the "
+        "range of real materials and rigs, outside which a value is refused unless the "
+        "config sets `allow_unphysical = true` (at its top level). A dotted key "
+        "`contact.load` is the key `load` of the table "
         "`[contact]`; from Python the same keys go in nested dicts "
         "(`{\"contact\": {\"load\": 50.0}}`), and in a sweep table they are column names. "
         "Units are SI unless the key's name says otherwise (`load_kN`, `rpm`). A key the "
@@ -330,9 +503,11 @@ def config_page() -> str:
               + ", ".join(flat_preset(DemRunConfig.QUICK)) + ".", ""]
     cal = dict(commands())["tribodem calibrate"]
     lines += ["## Calibration options", "",
-              "`tribodem calibrate` has no config file; its options (and the keyword "
-              "arguments of `tribodem.materials.calibrate(material, out, ...)`, same "
-              "names without the dashes):", "", OPTION_HEADER, *option_rows(cal), ""]
+              "`tribodem calibrate` has no config file; its options are below. "
+              "`tribodem.materials.calibrate(material, out, ...)` takes the same names as "
+              "keyword arguments (without the dashes; `progress=True` for the bar); from "
+              "Python `workers` left out runs in the calling process.", "", OPTION_HEADER,
+              *option_rows(cal), ""]
     return "\n".join(lines).rstrip() + "\n"
 
 
@@ -363,7 +538,14 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--check", action="store_true",
                     help="exit 1 (and show the difference) when a page is not current")
+    ap.add_argument("--undescribed", action="store_true",
+                    help="list the config keys whose model field has no description")
     args = ap.parse_args(argv)
+    if args.undescribed:
+        keys = undescribed()
+        print("\n".join(f"{k}{'' if k in MISSING else '  (no description at all)'}"
+                        for k in keys))
+        return 0
     stale = 0
     for path, make in PAGES.items():
         text = make()

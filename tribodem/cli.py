@@ -9,6 +9,8 @@ exit 2 = bad input (refused before any work), exit 3 = run stopped (instability)
 from __future__ import annotations
 
 import errno
+import os
+import re
 import sys
 
 import typer
@@ -133,7 +135,8 @@ Ctrl-C, 143 SIGTERM, after saying where the outputs and the last checkpoint are.
             raise
         # a fault of the file system: before any work nothing was touched (exit 2); during
         # a run the last complete outputs and checkpoint are kept (exit 3)
-        what = f"{err.strerror or err}" + (f": '{err.filename}'" if err.filename else "")
+        what = f"{err.strerror or err}" + (f": '{_intended(err.filename)}'"
+                                            if err.filename else "")
         if not runs.started():
             typer.echo(f"error: cannot write the outputs: {what}", err=True)
             sys.exit(2)
@@ -167,6 +170,20 @@ def _refuse_empty_values(argv: list[str]) -> None:
 FILE_SYSTEM_FAULTS = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EACCES, errno.EPERM,
                                 errno.ENAMETOOLONG, errno.EROFS, errno.EIO, errno.ENOTDIR,
                                 errno.EISDIR, errno.EEXIST, errno.ENOENT})
+
+
+#: the temporary an atomic write makes beside its file (tribodem.io.results.atomic_write):
+#: ``.NAME.XXXXXXXX.tmp`` + NAME's suffix
+_TEMPORARY = re.compile(r"^\.(?P<name>.+)\.[A-Za-z0-9_]{8}\.tmp(\.[^/]*)?$")
+
+
+def _intended(filename: object) -> str:
+    """The file a fault of the file system was about: for the temporary of an atomic write,
+    the file it was to become (the name the user knows); else ``filename`` as it is."""
+    text = os.fsdecode(filename) if isinstance(filename, str | bytes) else str(filename)
+    head, _, tail = text.rpartition("/")
+    m = _TEMPORARY.match(tail)
+    return f"{head}/{m['name']}" if m and head else m["name"] if m else text
 
 
 def _interrupt_in_chain(err: BaseException) -> bool:

@@ -1,6 +1,6 @@
-"""``tribodem braking run`` and ``tribodem braking sweep`` (seed 000 sections 3.2-5, table 4):
-the options parsed, then :func:`tribodem.braking.run` / :func:`tribodem.braking.sweep`
-called and their result printed.
+"""``tribodem braking run`` and ``tribodem braking sweep`` (seed 000, Sha et al. 2022:
+sections 3.2-5, table 4): the options parsed, then :func:`tribodem.braking.run` /
+:func:`tribodem.braking.sweep` called and their result printed.
 
 Configuration: defaults < ``--config`` file < ``--quick`` preset < ``--condition``
 (:mod:`tribodem.braking.config`). What a run and a sweep do, write, resume and refuse is
@@ -19,8 +19,10 @@ import typer
 from tribodem.braking.api import run, sweep
 from tribodem.braking.conditions import CONDITIONS
 from tribodem.io.config import ConfigError, parse_int_list
+from tribodem.io.helptext import reflowed
 
-braking_app = typer.Typer(help="Braking interface wear model (seed 000).", no_args_is_help=True)
+braking_app = typer.Typer(help="Braking interface wear model (Sha et al. 2022, Lubricants).",
+                          no_args_is_help=True)
 
 #: what ``braking run`` prints of the summary
 SHOWN = ("status", "condition", "pressure_Pa", "sliding_speed_m_s", "simulated_time_s",
@@ -32,10 +34,13 @@ SHOWN = ("status", "condition", "pressure_Pa", "sliding_speed_m_s", "simulated_t
 
 
 @braking_app.command("run")
+@reflowed
 def braking_run(
     out: Path = typer.Option(..., "--out", help="Output directory (an earlier run there is "
                              "replaced unless --resume)."),
-    condition: int | None = typer.Option(None, "--condition", help="Table 4 condition 1..5."),
+    condition: int | None = typer.Option(
+        None, "--condition",
+        help="Braking condition 1..5: load and speed of table 4 of Sha et al. 2022."),
     config: Path | None = typer.Option(None, "--config", help="TOML config file."),
     quick: bool = typer.Option(False, "--quick", help="Small, fast variant (< 3 min); it "
                                "overrides the config file, --condition overrides both."),
@@ -77,6 +82,7 @@ def parse_packings(packings: int | None, seeds: int | None) -> int:
 
 
 @braking_app.command("sweep")
+@reflowed
 def braking_sweep(
     out: Path = typer.Option(..., "--out", help="Output directory; re-running the same sweep "
                              "there skips finished members and resumes the others."),
@@ -91,9 +97,9 @@ def braking_sweep(
                                      help="Deprecated alias of --packings."),
     conditions: str | None = typer.Option(
         None, "--conditions",
-        help="Which conditions of table 4 to run, e.g. 1,3,5 (the two end-to-end trends, "
-             "13 -> 21 kN and 800 -> 1200 r/min, at 3/5 of the cost); changes needing an "
-             "absent condition are left unevaluated. Default: all five."),
+        help="Which conditions (table 4 of Sha et al. 2022) to run, e.g. 1,3,5 (the two "
+             "end-to-end trends, 13 -> 21 kN and 800 -> 1200 r/min, at 3/5 of the cost); "
+             "changes needing an absent condition are left unevaluated. Default: all five."),
     workers: int = typer.Option(
         0, "--workers", min=0, max=1024,
         help="Worker processes of the local Dask cluster (1 thread each); 0 = all local "
@@ -108,8 +114,8 @@ def braking_sweep(
                                        "stderr."),
 ) -> None:
     """Conditions 1-5 (or --conditions) x --packings on Dask: comparison.md,
-    comparison.json, comparison.csv (ours with paired 95% intervals beside the seed's),
-    members.csv (one row per member).
+    comparison.json, comparison.csv (ours with paired 95% intervals beside the paper's,
+    Sha et al. 2022 section 5), members.csv (one row per member).
 
     Each (condition, packing) member is an independent, idempotent task with its own
     folder and checkpoints; a re-run with the same --out skips the finished members,

@@ -26,8 +26,31 @@ SEED_FIG12 = [(0.1, 3.66e-7), (0.5, 5.42e-6), (1.0, 1.16e-5), (2.0, 2.15e-5), (4
               (8.0, 7.69e-5)]
 
 
+#: why a change has no percentage (:func:`pct_reason`)
+NOT_POSITIVE = ("a change in percent is given only between two positive quantities "
+                "(a negative wear rate: the measured wear depth fell over the distance slid)")
+
+
 def _pct(a: float, b: float) -> float:
-    return 100.0 * (b - a) / a if a else float("nan")
+    """The change from ``a`` to ``b`` in percent of ``a``; nan unless both are positive
+    (between negative or zero quantities a percentage misleads: from -1 to -2.26 would read
+    +126 %)."""
+    return 100.0 * (b - a) / a if positive(a) and positive(b) else float("nan")
+
+
+def positive(x: float | None) -> bool:
+    """Whether ``x`` is a finite positive number."""
+    return x is not None and bool(np.isfinite(x)) and x > 0
+
+
+def pct_reason(a: float | None, b: float | None) -> str | None:
+    """Why the change from ``a`` to ``b`` has no percentage (None when it has one): a
+    quantity missing (a condition without a run) or not positive (:data:`NOT_POSITIVE`)."""
+    if a is None or b is None or not (np.isfinite(a) and np.isfinite(b)):
+        return "a condition has no value (not run, or all its members failed)"
+    if positive(a) and positive(b):
+        return None
+    return f"from {a:.4g} to {b:.4g}: {NOT_POSITIVE}"
 
 
 def _series(run_dir: Path) -> dict[str, np.ndarray]:
@@ -55,7 +78,7 @@ def change_with_error(a: np.ndarray, b: np.ndarray, paired: bool = True
     a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
     ma, mb = float(a.mean()), float(b.mean())
     pct = _pct(ma, mb)
-    if min(a.size, b.size) < 2 or ma == 0 or mb == 0:
+    if min(a.size, b.size) < 2 or not np.isfinite(pct):
         return pct, float("nan")
     if paired and a.size == b.size:
         return pct, 100.0 * float((b - a).std(ddof=1)) / np.sqrt(a.size) / abs(ma)
@@ -76,7 +99,10 @@ def _factor(n: int | None) -> float:
 
 def step_verdict(pct: float, se: float, n: int | None = None) -> str:
     """``up`` / ``down`` when the change exceeds ``_factor(n)`` standard errors (95% t
-    for n seeds), else ``not resolved`` (``no scatter`` with one seed)."""
+    for n seeds), else ``not resolved`` (``no scatter`` with one seed; ``no change in
+    percent`` when ``pct`` is nan: :func:`pct_reason`)."""
+    if not np.isfinite(pct):
+        return "no change in percent (a quantity is not positive)"
     if not np.isfinite(se):
         return "no scatter (1 seed)"
     k = _factor(n)
@@ -91,6 +117,9 @@ def trend_verdict(steps: list[tuple[float, float]], total: tuple[float, float],
                   want: str, n: int | None = None) -> str:
     """Verdict on a seed trend (``want`` = ``up`` or ``down``) from its two steps and the
     total change, each (pct, se), over n seeds."""
+    if not np.isfinite(total[0]):
+        return ("not evaluated: the total change has no percentage (a quantity is not "
+                "positive, or a condition has no value)")
     tv = step_verdict(*total, n)
     sv = [step_verdict(*x, n) for x in steps]
     other = "down" if want == "up" else "up"
@@ -107,11 +136,14 @@ def trend_verdict(steps: list[tuple[float, float]], total: tuple[float, float],
 
 
 def steady_rate(r: dict[str, Any]) -> float:
-    """A run's steady wear rate per sliding distance (m/m): ``wear_rate_steady_m_per_m``
-    (after the run-in), or for runs made before that field the second-half rate in time
-    divided by the speed."""
-    if "wear_rate_steady_m_per_m" in r:
-        return float(r["wear_rate_steady_m_per_m"])
+    """A run's wear rate per sliding distance after the run-in (m/m): the slope over the
+    last two thirds of its distance, ``wear_rate_last_two_thirds_m_per_m`` (whether the
+    steady-state rule passed or not: ``steady_reached``; runs made before that field have
+    it as ``wear_rate_steady_m_per_m``), or for runs made before both the second-half rate
+    in time divided by the speed."""
+    for key in ("wear_rate_last_two_thirds_m_per_m", "wear_rate_steady_m_per_m"):
+        if r.get(key) is not None:
+            return float(r[key])
     return float(r["steady_wear_rate_m_s"]) / float(r["sliding_speed_m_s"])
 
 
@@ -299,7 +331,9 @@ def _add_change(t: ChangeTable, st: SweepStats, label: str, a: int, b: int, seed
     t.rows_csv.append([label, a, b, n_seeds, wear[a], wear[b], ow, ow_se,
                        step_verdict(ow, ow_se, n_seeds), seed_w, rate[a], rate[b], orr, orr_se,
                        step_verdict(orr, orr_se, n_seeds), chains[a], chains[b], oc, oc_se,
-                       "" if seed_c is None else seed_c, os_, hw, hr, hc])
+                       "" if seed_c is None else seed_c, os_, hw, hr, hc,
+                       pct_reason(wear[a], wear[b]) or "", pct_reason(rate[a], rate[b]) or "",
+                       pct_reason(chains[a], chains[b]) or ""])
     inside_w, inside_c = seed_inside(seed_w, ow, hw), seed_inside(seed_c, oc, hc)
     t.lines.append(f"| {label} | {a}->{b} | {wear[a] * 1e6:.2f} -> {wear[b] * 1e6:.2f} | "
                    f"{_ci(ow, hw)} | {_fmt(seed_w)} | {_yes(inside_w)} | "
@@ -315,9 +349,12 @@ def _add_change(t: ChangeTable, st: SweepStats, label: str, a: int, b: int, seed
             ("force_chains", seed_c, oc, hc, inside_c, oc_se, packings_for(oc_se, n_seeds))):
         if seed_pct is None:
             continue
+        frm, to = (st.wear[a], st.wear[b]) if q == "wear_depth" else (chains[a], chains[b])
         t.trends_json.append({
             "change": label, "from_condition": a, "to_condition": b, "quantity": q,
-            "seed_pct": seed_pct, "ours_pct": _num(pct), "ci95_pct": _num(half),
+            "seed_pct": seed_pct, "ours_pct": _num(pct),
+            "ours_pct_reason": None if np.isfinite(pct) else pct_reason(frm, to),
+            "ci95_pct": _num(half),
             "se_pct": _num(se), "reproduced": inside,
             "packings_for_ci95_10pp": need_q,
             "resolved": None if not np.isfinite(half) else bool(abs(pct) > half)})
@@ -341,7 +378,8 @@ CSV_COLUMNS = [
     "force_chains_change_pct", "force_chains_change_se_pct",
     "seed_force_chains_change_pct", "strong_force_chains_change_pct",
     "wear_depth_change_ci95_pct", "wear_rate_change_ci95_pct",
-    "force_chains_change_ci95_pct"]
+    "force_chains_change_ci95_pct", "wear_depth_change_reason", "wear_rate_change_reason",
+    "force_chains_change_reason"]
 
 
 def _trend(st: SweepStats, q: str, ks: tuple[int, int, int], want: str) -> str:
@@ -465,7 +503,8 @@ def _md_conditions(st: SweepStats, wall_s: float, cluster: str | int, quick: boo
         f"seeds. {length_text(st.results, st.t_sim)} Wear depth = mean pad "
         "wear depth at the end (worn solid area / (packing fraction x width)); steady wear "
         "rate = wear depth per sliding distance after the run-in (summary.json "
-        "`wear_rate_steady_m_per_m`: slope over the last two thirds of the distance); "
+        "`wear_rate_last_two_thirds_m_per_m`: slope over the last two thirds of the "
+        "distance, whether or not the run's steady-state rule passed, `steady_reached`); "
         "contact fraction = share of the time the interface carries load; force chains = "
         "time mean over the second half of the run.",
         "",
@@ -496,7 +535,8 @@ def _md_changes(st: SweepStats, t: ChangeTable) -> list[str]:
            if n_seeds > 1 else "(none with one packing: use --packings N). ") +
         "'seed inside' (comparison.json `reproduced`): the seed's change lies inside our "
         "interval, |seed - ours| <= half-width; 'verdict': our interval excludes 0 "
-        "(up/down) or not (not resolved).",
+        f"(up/down) or not (not resolved). '-': no change in percent: {NOT_POSITIVE} "
+        "(comparison.csv `*_change_reason`).",
         "",
         "| change | conditions | our wear depth um | our wear change (95%) | seed wear change "
         "| seed inside | verdict | our wear-rate change (95%) | verdict | our force chains | "

@@ -12,17 +12,20 @@ resume compares the config it is given with the checkpoint's field by field
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import Any, Literal
 
 from pydantic import BaseModel, Field, model_validator
 
 from tribodem.braking.conditions import get_condition, load_to_pressure, rpm_to_speed
-from tribodem.braking.model import Geometry, materials
+from tribodem.braking.model import PHI_TARGET, Geometry, materials
 from tribodem.braking.setup import RunSetup
+from tribodem.dem.state import BYTES_PER_PARTICLE
 from tribodem.dem.thermal import read_curve
+from tribodem.io import runs
 from tribodem.io.config import ConfigError, validate
-from tribodem.io.model import StrictModel
+from tribodem.io.model import PhysicalConfig, StrictModel, physical
 from tribodem.io.record import ConfigSource, Source, config_diffs, may_change_text, read_source
 from tribodem.io.record import resolve as resolve_model
 
@@ -31,10 +34,16 @@ class ConditionCfg(StrictModel):
     """Table 4 ``index`` or an explicit load (kN or Pa) and speed (r/min or m/s)."""
 
     index: int | None = Field(None, ge=1, le=5, description="table 4 condition 1..5")
-    load_kN: float | None = Field(None, gt=0)
-    pressure_Pa: float | None = Field(None, gt=0)
-    rpm: float | None = Field(None, gt=0)
-    speed_m_s: float | None = Field(None, gt=0)
+    load_kN: float | None = Field(None, gt=0, **physical(
+        1e-3, 1e4, "kN", "brake load, kN (table 4; turned into the pad pressure by the pad "
+        "area the table implies: 13 kN -> 0.33 MPa)"))
+    pressure_Pa: float | None = Field(None, gt=0, **physical(
+        1e3, 1e9, "Pa", "pressure on the pad, Pa (instead of load_kN)"))
+    rpm: float | None = Field(None, gt=0, **physical(
+        1e-2, 25_000.0, "r/min", "disc speed, r/min (table 4; turned into the sliding speed "
+        "at the friction radius the table implies: 1200 r/min -> 47.12 m/s)"))
+    speed_m_s: float | None = Field(None, gt=0, **physical(
+        1e-3, 1000.0, "m/s", "sliding speed, m/s (instead of rpm)"))
 
     @model_validator(mode="after")
     def _one_form(self) -> ConditionCfg:
@@ -48,15 +57,23 @@ class ConditionCfg(StrictModel):
 class GeometryCfg(StrictModel):
     """Interface cell sizes (m)."""
 
-    width_m: float = Field(216e-6, gt=0)
-    disc_height_m: float = Field(72e-6, gt=0)
-    pad_height_m: float = Field(108e-6, gt=0)
-    roughness_amplitude_m: float = Field(8e-6, ge=0)
+    width_m: float = Field(216e-6, gt=0, **physical(
+        1e-6, 0.5, "m", "cell width along the sliding (periodic), m (the cell's particles "
+        "must fit in memory)"))
+    disc_height_m: float = Field(72e-6, gt=0, **physical(
+        1e-6, 0.1, "m", "disc (Q345B) height, m"))
+    pad_height_m: float = Field(108e-6, gt=0, **physical(
+        1e-6, 0.1, "m", "pad (Cu-based powder metallurgy) height, m"))
+    roughness_amplitude_m: float = Field(8e-6, ge=0, **physical(
+        0.0, 1e-2, "m", "largest height of the random sine profiles cut into both surfaces, "
+        "m"))
     roughness_modes: int = Field(4, ge=1, le=64)
     roughness_first_mode: int = Field(
         1, ge=1, le=64, description="lowest sine mode k (wavelength width/k); in a cell n "
         "times the default width, n keeps the default cell's wavelengths and asperities")
-    clearance_m: float = Field(5e-8, ge=0)
+    clearance_m: float = Field(5e-8, ge=0, **physical(
+        0.0, 1e-2, "m", "gap between the pad's lowest and the disc's highest point at the "
+        "start, m"))
     seed: int = Field(0, ge=0)
 
 
@@ -128,7 +145,7 @@ class ThermalCfg(StrictModel):
     time_map: Literal["simulated", "stretched"] = "simulated"
 
 
-class BrakingConfig(StrictModel):
+class BrakingConfig(PhysicalConfig):
     """``tribodem braking run`` configuration (TOML tables)."""
 
     condition: ConditionCfg = ConditionCfg()
@@ -198,8 +215,8 @@ def _pressure_speed(c: ConditionCfg) -> tuple[float, float]:
     elif base is not None:
         p = base.pressure_Pa
     else:
-        raise ConfigError("braking: no load: give --condition 1..5 or [condition] index, "
-                          "load_kN or pressure_Pa")
+        raise ConfigError("braking: no load: give --condition 1..5 or condition.index, "
+                          "condition.load_kN or condition.pressure_Pa")
     if c.speed_m_s is not None:
         v = c.speed_m_s
     elif c.rpm is not None:
@@ -207,8 +224,8 @@ def _pressure_speed(c: ConditionCfg) -> tuple[float, float]:
     elif base is not None:
         v = base.speed_m_s
     else:
-        raise ConfigError("braking: no speed: give --condition 1..5 or [condition] index, "
-                          "rpm or speed_m_s")
+        raise ConfigError("braking: no speed: give --condition 1..5 or condition.index, "
+                          "condition.rpm or condition.speed_m_s")
     return p, v
 
 
@@ -219,12 +236,41 @@ def _geometry(cfg: BrakingConfig) -> Geometry:
     geo = Geometry(width=g.width_m, disc_height=g.disc_height_m, pad_height=g.pad_height_m,
                    amplitude=g.roughness_amplitude_m, modes=g.roughness_modes,
                    first_mode=g.roughness_first_mode, clearance=g.clearance_m, seed=g.seed)
-    rmax = max(m.radius_range[1] for m in materials(cfg.run.micro))
+    specs = materials(cfg.run.micro)
+    rmax = max(m.radius_range[1] for m in specs)
     try:
         geo.check(rmax)
     except ValueError as err:
         raise ConfigError(f"braking: {err}") from None
+    check_cell_memory(cfg)
     return geo
+
+
+def cell_particles(cfg: BrakingConfig) -> float:
+    """About how many grains the cell's two bodies hold (a float: an estimate, infinite for
+    a cell too large to count): each body's area (width x height) at the packing's area
+    fraction over its grains' mean area, as :func:`tribodem.braking.model.compact_once`
+    counts them."""
+    g = cfg.geometry
+    disc, pad = materials(cfg.run.micro)
+    total = 0.0
+    for spec, height in ((disc, g.disc_height_m), (pad, g.pad_height_m)):
+        rmin, rmax = spec.radius_range
+        mean_area = math.pi * (rmin * rmin + rmin * rmax + rmax * rmax) / 3.0
+        total += PHI_TARGET * g.width_m * height / mean_area
+    return total
+
+
+def check_cell_memory(cfg: BrakingConfig) -> None:
+    """Refuse (``ConfigError`` naming ``geometry.width_m`` and the heights) a cell whose
+    grains would not fit in the memory this machine has (:func:`cell_particles`; before
+    any output)."""
+    g = cfg.geometry
+    runs.check_memory(
+        cell_particles(cfg), BYTES_PER_PARTICLE, "geometry.width_m",
+        given=f"{g.width_m!r} m (disc_height_m {g.disc_height_m!r} m, pad_height_m "
+              f"{g.pad_height_m!r} m)", what="the cell's particles",
+        allowed="a smaller cell (geometry.width_m x the heights)")
 
 
 def setup_from_config(cfg: BrakingConfig) -> RunSetup:

@@ -10,7 +10,7 @@ import numpy as np
 
 from tribodem.braking.measure import Reference, classify, force_chains
 from tribodem.braking.model import DISC, Interface
-from tribodem.io.vtk import write_lines, write_points, write_pvd
+from tribodem.io.vtk import has_lines, write_lines, write_points, write_pvd
 
 
 def body_displacement(iface: Interface, ref: Reference, slid: float) -> np.ndarray:
@@ -41,8 +41,11 @@ def write_snapshot(out: Path, iface: Interface, ref: Reference, slid: float, k: 
                    t: float, entries: list[tuple[float, str]],
                    chain_entries: list[tuple[float, str]]) -> None:
     """VTK snapshot ``k`` at simulated time ``t`` (s) in folder ``out``: the particles
-    (``particles_KKKK.vtu``) and the force chains (``chains_KKKK.vtu``); each is added
-    to its index (``entries``, ``chain_entries``) and the ``.pvd`` files rewritten."""
+    (``particles_KKKK.vtu``) and the force chains (``chains_KKKK.vtu``: line cells between
+    the particles' centres, with their normal force; none at a snapshot without any chain,
+    such as the first one, before the plate loads the interface: a ``.vtu`` without cells
+    could not be read back by meshio); each is added to its index (``entries``,
+    ``chain_entries``) and the ``.pvd`` files rewritten."""
     p = iface.sim.p
     matrix, lab = classify(iface)
     name = f"particles_{k:04d}.vtu"
@@ -54,9 +57,11 @@ def write_snapshot(out: Path, iface: Interface, ref: Reference, slid: float, k: 
     write_pvd(out / "particles.pvd", entries)
     ch = force_chains(iface)
     f = ch["force"]
+    lines = np.stack([ch["i"], ch["j"]], axis=1)
+    if not has_lines(lines):
+        return
     cname = f"chains_{k:04d}.vtu"
-    write_lines(out / cname, p.pos, np.stack([ch["i"], ch["j"]], axis=1), {
-        "normal_force": f, "strong": (np.abs(f) > np.abs(f).mean()).astype(np.int32)
-        if f.size else np.zeros(0, dtype=np.int32)})
+    write_lines(out / cname, p.pos, lines, {
+        "normal_force": f, "strong": (np.abs(f) > np.abs(f).mean()).astype(np.int32)})
     chain_entries.append((t, cname))
     write_pvd(out / "chains.pvd", chain_entries)

@@ -111,37 +111,51 @@ def _plot_chains(out: Path, fr: dict[str, np.ndarray], w: float) -> None:
     write_figure(out / "force_chains.png", fig)
 
 
+#: wear_history.png's panels: (title, y label, [(row key, legend label, scale)]): one
+#: quantity per axis, in its unit
+HISTORY_PANELS = (
+    ("wear depth", "depth (um)", [
+        ("wear_depth_mean_pad_m", "pad, mean", 1e6), ("wear_depth_max_pad_m", "pad, max", 1e6),
+        ("wear_depth_mean_disc_m", "disc, mean", 1e6),
+        ("transfer_layer_thickness_m", "transfer layer thickness", 1e6)]),
+    ("broken bonds", "bonds broken (count)", [
+        ("broken_bonds", "all", 1.0), ("broken_bonds_tensile", "in tension", 1.0),
+        ("broken_bonds_shear", "in shear", 1.0)]),
+    ("debris", "debris (count)", [
+        ("debris_particles", "particles", 1.0),
+        ("debris_clusters", "clusters (connected pieces)", 1.0)]),
+    ("force chains", "force chains (count)", [
+        ("force_chains", "all", 1.0), ("strong_force_chains", "strong (|F| > mean)", 1.0),
+        ("weak_force_chains", "weak", 1.0), ("compressive_force_chains", "compressive", 1.0),
+        ("tensile_force_chains", "tensile", 1.0)]),
+    ("pressure plate: pressure", "plate pressure (MPa)", [("wall_pressure_Pa", "plate", 1e-6)]),
+    ("pressure plate: travel", "plate displacement (um)", [("wall_displacement_m", "plate",
+                                                             1e6)]),
+)
+
+
 def _plot_history(out: Path, rows: list[dict[str, float]], summary: dict[str, Any]) -> None:
-    """wear_history.png (figs 12, 18): depths (um), bonds and debris, force chains, the
-    plate's pressure (MPa) and displacement (um) against the simulated time (us)."""
+    """wear_history.png (figs 12, 18) against the simulated time (us), one quantity per
+    axis with its unit (:data:`HISTORY_PANELS`): the wear depths (um), the broken bonds,
+    the debris, the force chains (counts), the plate's pressure (MPa, with the target) and
+    its displacement (um)."""
     plt = _plt()
     t = np.array([r["time_s"] for r in rows]) * 1e6
-    fig, axes = plt.subplots(2, 2, figsize=(10, 7))
-    ax = axes[0, 0]
-    for key, lab in (("wear_depth_mean_pad_m", "pad mean"), ("wear_depth_max_pad_m", "pad max"),
-                     ("wear_depth_mean_disc_m", "disc mean"),
-                     ("transfer_layer_thickness_m", "transfer layer")):
-        ax.plot(t, np.array([r[key] for r in rows]) * 1e6, label=lab)
-    ax.set_ylabel("depth (um)")
-    ax.legend(fontsize=7)
-    ax = axes[0, 1]
-    for key in ("broken_bonds", "broken_bonds_tensile", "broken_bonds_shear",
-                "debris_particles", "debris_clusters"):
-        ax.plot(t, [r[key] for r in rows], label=key)
-    ax.legend(fontsize=7)
-    ax = axes[1, 0]
-    for key in ("force_chains", "strong_force_chains", "weak_force_chains",
-                "tensile_force_chains", "compressive_force_chains"):
-        ax.plot(t, [r[key] for r in rows], label=key)
-    ax.legend(fontsize=7)
-    ax.set_xlabel("simulated time (us)")
-    ax = axes[1, 1]
-    ax.plot(t, np.array([r["wall_pressure_Pa"] for r in rows]) / 1e6, lw=0.7,
-            label="wall pressure (MPa)")
-    ax.axhline(summary["pressure_Pa"] / 1e6, color="k", ls="--", label="target")
-    ax.plot(t, np.array([r["wall_displacement_m"] for r in rows]) * 1e6, label="wall dy (um)")
-    ax.legend(fontsize=7)
-    ax.set_xlabel("simulated time (us)")
+    fig, axes = plt.subplots(3, 2, figsize=(11, 10), sharex=True)
+    for ax, (title, ylabel, curves) in zip(axes.flat, HISTORY_PANELS, strict=True):
+        for key, lab, scale in curves:
+            ax.plot(t, np.array([r[key] for r in rows]) * scale,
+                    lw=0.8 if key.startswith("wall_") else 1.2, label=lab)
+        if curves[0][0] == "wall_pressure_Pa":
+            ax.axhline(summary["pressure_Pa"] / 1e6, color="k", ls="--", lw=0.8,
+                       label="target")
+        ax.set_title(title, fontsize=10)
+        ax.set_ylabel(ylabel)
+        if len(ax.get_lines()) > 1:
+            ax.legend(fontsize=8)
+        ax.grid(alpha=0.3)
+    for ax in axes[-1]:
+        ax.set_xlabel("simulated time (us)")
     fig.suptitle(f"condition {summary['condition']}: {summary['pressure_Pa'] / 1e6:.3g} MPa, "
                  f"{summary['sliding_speed_m_s']:.4g} m/s")
     fig.tight_layout()

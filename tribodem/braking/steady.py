@@ -70,6 +70,28 @@ def steady_state(s: np.ndarray, h: np.ndarray, tol: float = 0.15,
             "run_in_depth": float(np.interp(a, s, h))}
 
 
+def steady_reason(st: dict[str, Any], tol: float) -> str | None:
+    """Why :func:`steady_state`'s result ``st`` has no steady rate (None when it has one):
+    too few rows, a middle-third rate that is not positive, or a last-third rate outside
+    ``tol`` of it (on the whole run or on one of its cuts)."""
+    if st["steady"]:
+        return None
+    mid, last = st["rate_mid"], st["rate_last"]
+    if not np.isfinite(mid):
+        return ("too few measurement rows (at least 6 over a positive sliding distance) for "
+                "the steady-state rule")
+    if not mid > 0:
+        return (f"the steady-state rule needs a positive wear rate, but the middle third's "
+                f"is {mid:.4g} m/m (the wear depth does not grow with the distance slid)")
+    if abs(last - mid) > tol * mid:
+        return (f"the rate is still changing: the last third's ({last:.4g} m/m) is not "
+                f"within +-{100 * tol:g}% of the middle third's ({mid:.4g} m/m) within the "
+                "distance slid")
+    return (f"the last third's rate ({last:.4g} m/m) is within +-{100 * tol:g}% of the "
+            f"middle third's ({mid:.4g} m/m) on the whole run, but not on the run cut to "
+            f"{', '.join(f'{f:.0%}' for f in STEADY_CUTS[1:])} of its distance")
+
+
 def wear_vs_distance(rows: list[dict[str, float]]) -> tuple[np.ndarray, np.ndarray]:
     """(sliding distance m, mean wear depth m) of every measurement row."""
     return (np.array([r["sliding_distance_m"] for r in rows]),

@@ -7,7 +7,10 @@ represents (``equivalent_braking_time_s = simulated_time_s``); the seed's 8 s of
 (377 m at 47 m/s) are out of reach, so the summary reports the fraction simulated and,
 separately labelled, a linear extrapolation of the mean wear depth to 8 s from the steady
 wear rate (least-squares slope over the second half of the run). Every summary reports
-``wear_rate_steady_m_per_m``, the run-in distance and depth, and ``contact_fraction``
+``wear_rate_steady_m_per_m`` (null with ``wear_rate_steady_reason`` when the steady-state
+rule did not pass: the slope over the last two thirds is then
+``wear_rate_last_two_thirds_m_per_m`` only), the run-in distance and depth, and
+``contact_fraction``
 (share of looks, one every ``CONTACT_EVERY`` steps, at which a disc-pad contact carries
 load).
 """
@@ -26,6 +29,7 @@ from tribodem.braking.model import DISC, EJECTED, Interface
 from tribodem.braking.setup import RunSetup
 from tribodem.braking.steady import (
     STEADY_CUTS,
+    steady_reason,
     steady_state,
     wear_extrapolation,
     wear_vs_distance,
@@ -97,7 +101,10 @@ def _rate_fields(loop: BrakingLoop) -> dict[str, Any]:
     looks = max(drive.contact[0], 1.0)
     return {
         "steady_wear_rate_m_s": rate,
-        "wear_rate_steady_m_per_m": st["rate"],
+        # a rate is called steady only when the rule passed; else null, and why
+        "wear_rate_steady_m_per_m": st["rate"] if st["steady"] else None,
+        "wear_rate_steady_reason": steady_reason(st, setup.steady_tolerance),
+        "wear_rate_last_two_thirds_m_per_m": st["rate"],
         "wear_rate_middle_third_m_per_m": st["rate_mid"],
         "wear_rate_last_third_m_per_m": st["rate_last"],
         "steady_reached": st["steady"],
@@ -245,8 +252,9 @@ def outcome_notes(summary: dict[str, Any]) -> list[str]:
     if not summary["steady_reached"]:
         notes.append(
             "steady-state rule not passed within the distance slid: "
-            "wear_rate_steady_m_per_m is the slope over the last two thirds of a rate still "
-            "changing (compare wear_rate_middle_third_m_per_m and "
+            "wear_rate_steady_m_per_m is null (wear_rate_steady_reason says why); "
+            "wear_rate_last_two_thirds_m_per_m is the slope over the last two thirds of a "
+            "rate still changing (compare wear_rate_middle_third_m_per_m and "
             "wear_rate_last_third_m_per_m)" + (
                 "" if summary["outlet_length_m"] > 0 else
                 "; in the closed periodic cell the rate falls towards zero over ~10-16 mm as "

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import logging
 import tempfile
 from pathlib import Path
 from typing import Annotated
@@ -10,11 +11,15 @@ from typing import Annotated
 import typer
 
 from tribodem.io.config import ConfigError
+from tribodem.io.helptext import reflowed
 
 #: backends with closed-form checks
 SOLVERS = ("elastic", "fe")
 
+log = logging.getLogger(__name__)
 
+
+@reflowed
 def validate(
     solver: Annotated[str, typer.Option("--solver", help=f"One of: {', '.join(SOLVERS)}.")]
     = "elastic",
@@ -40,15 +45,20 @@ def validate(
             raise ConfigError("--solver = 'fe' needs CalculiX's ccx, which is not on PATH; "
                               f"install it with: {INSTALL_COMMAND}")
         from tribodem.contact.fe.validate import validate_fe
-        from tribodem.io.runs import announce
+        from tribodem.io.runs import announce, check_out_dir
 
         if keep is not None:  # Ctrl-C names the folder of the kept jobs
+            check_out_dir(keep, "--keep")  # a folder (or a new one), writable
             announce(keep, resume_hint="the checks start again from the beginning")
         with tempfile.TemporaryDirectory(prefix="tribodem_fe_") as tmp:
+            log.info("validate: the plane-strain checks, one ccx job after another (about a "
+                     "minute)...")
             checks = validate_fe(keep or tmp, threads=1)
             if three_d:
                 from tribodem.contact.fe.crossed import crossed_checks
 
+                log.info("validate: the 3D crossed-cylinder checks (minutes of ccx; --no-3d "
+                         "leaves them out)...")
                 checks += crossed_checks(Path(keep or tmp), threads=1)
     else:
         from tribodem.contact.validate import halfspace_checks

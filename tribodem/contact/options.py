@@ -14,10 +14,13 @@ from typing import Any, Literal, TypeVar
 
 from pydantic import BaseModel, Field
 
-from tribodem.io.model import StrictModel
+from tribodem.io.model import StrictModel, physical
 from tribodem.materials.en24t import EN24T
 
 M = TypeVar("M", bound=BaseModel)
+
+#: Physical range of yield and tensile strengths, Pa (soft polymers to ceramics).
+STRENGTH_RANGE = (1e5, 2e10)
 
 
 class ElasticOptions(StrictModel):
@@ -36,11 +39,14 @@ class PlasticOptions(StrictModel):
     of the ccx backends' ``[fe] material = "elastic-plastic"``: bilinear EN24T (seed table
     5.1), one law for every backend."""
 
-    yield_strength: float = Field(EN24T.yield_strength, gt=0, description="initial yield, Pa")
-    uts: float = Field(EN24T.uts, gt=0, description="ultimate tensile strength, Pa")
+    yield_strength: float = Field(EN24T.yield_strength, gt=0, **physical(
+        *STRENGTH_RANGE, "Pa", "initial yield, Pa"))
+    uts: float = Field(EN24T.uts, gt=0, **physical(
+        *STRENGTH_RANGE, "Pa", "ultimate tensile strength, Pa"))
     uts_strain: float = Field(EN24T.uts_strain, gt=0, lt=1,
                               description="engineering strain at UTS")
-    hardening: float | None = Field(None, ge=0, description="h, Pa (None: bilinear)")
+    hardening: float | None = Field(None, ge=0, **physical(
+        0.0, 2e12, "Pa", "hardening modulus h, Pa (None: bilinear)"))
     beyond_uts: Literal["line", "hold"] = Field(
         "line", description="past the UTS: line, the hardening line goes on (seed fig. 5.5; "
         "tamaas's law, the only one it has); hold, the flow stress stays at the UTS (fe, "

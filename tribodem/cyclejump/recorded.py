@@ -14,6 +14,7 @@ from __future__ import annotations
 import csv
 import math
 import os
+import re
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -128,10 +129,15 @@ def make_checked_strategy(strategy: str, params: Mapping[str, Any] | None = None
     for an unknown name or a value the strategy refuses."""
     if strategy not in STRATEGIES:
         raise ConfigError(f"--strategy {strategy!r} is unknown; allowed: {', '.join(STRATEGIES)}")
+    given = dict(params or {})
     try:
-        return make_strategy(strategy, **dict(params or {}))
+        return make_strategy(strategy, **given)
     except (TypeError, ValueError) as err:
-        raise ConfigError(f"strategy '{strategy}' parameters: {err}") from None
+        # name the parameter the strategy refused, with its value (its message may not)
+        named = [k for k in given if re.search(rf"\b{re.escape(k)}\b", str(err))] or list(given)
+        shown = ", ".join(f"--param {k}={given[k]!r}" for k in named)
+        raise ConfigError(f"strategy '{strategy}'{': ' + shown if shown else ''}: {err}"
+                          ) from None
 
 
 def replay_csv(strategy: str, input: str | os.PathLike[str], *,

@@ -11,18 +11,22 @@ from pathlib import Path
 
 import typer
 
+from tribodem.io.helptext import reflowed
+
 dem_app = typer.Typer(help="Run the DEM engine on its own (demo scenarios).",
                       no_args_is_help=True)
 bench_app = typer.Typer(help="Measure performance.", no_args_is_help=True)
 
 
 @dem_app.command("run")
+@reflowed
 def dem_run(
     out: Path = typer.Option(..., "--out", help="Output directory."),
     config: Path | None = typer.Option(None, "--config", help="TOML config file."),
     quick: bool = typer.Option(False, "--quick", help="Small, fast variant."),
     resume: bool = typer.Option(False, "--resume", help="Continue from OUT/checkpoint.npz."),
-    progress: bool = typer.Option(True, "--progress/--no-progress"),
+    progress: bool = typer.Option(True, "--progress/--no-progress",
+                                  help="Progress bar with ETA on stderr."),
 ) -> None:
     """Settle spheres in a box (or compress disks): writes timeseries.csv, vtk/, summary.json."""
     from tribodem.dem.demo import run
@@ -31,6 +35,7 @@ def dem_run(
 
 
 @bench_app.command("dem")
+@reflowed
 def bench_dem(
     case: str = typer.Option("settle3d", "--case",
                              help="settle3d (Hertz), compress2d, dense3d (Hertz, "

@@ -10,7 +10,7 @@ from typing import Any, ClassVar, Literal
 
 from pydantic import Field
 
-from tribodem.io.model import StrictModel
+from tribodem.io.model import PhysicalConfig, StrictModel
 from tribodem.io.record import resolve
 
 
@@ -37,8 +37,13 @@ class OutputCfg(StrictModel):
     checkpoint_every: int = Field(2000, ge=0)
 
 
-class DemRunConfig(StrictModel):
-    """``tribodem dem run`` configuration (TOML tables [case], [run], [output])."""
+class DemRunConfig(PhysicalConfig):
+    """``tribodem dem run`` configuration (TOML tables [case], [run], [output]).
+
+    Its scenarios fix their materials and sizes, so it has no physically bounded field of
+    its own (``allow_unphysical`` is there as in every command's config); the particle
+    count is bounded by the memory this machine has (:func:`tribodem.io.runs.check_memory`,
+    before any work)."""
 
     #: The ``--quick`` preset, laid over the config (it wins over a config file): 1,000
     #: spheres for 3,000 steps, a snapshot and a checkpoint every 500.

@@ -36,6 +36,8 @@ from tribodem.contact.geometry import (
     load_height_map,
 )
 from tribodem.cyclejump import STRATEGIES, JumpStrategy, make_strategy
+from tribodem.dem.clumps import debris_template
+from tribodem.dem.state import BYTES_PER_PARTICLE
 from tribodem.fretting.config import (
     GEOMETRY_FIELDS,
     FrettingConfig,
@@ -43,7 +45,7 @@ from tribodem.fretting.config import (
     runs_ccx,
 )
 from tribodem.fretting.criteria import CRITERIA, Criterion, CriterionUnavailable, make_criterion
-from tribodem.fretting.debris import DebrisField, DebrisSettings
+from tribodem.fretting.debris import SHAPES, DebrisField, DebrisSettings, particle_count
 from tribodem.fretting.loop import FrettingLoop
 from tribodem.io import runs
 from tribodem.io.config import ConfigError
@@ -315,9 +317,7 @@ def scar_window(cfg: FrettingConfig, geo: Geometry, modulus: float, window: floa
     if default is None or need <= default:
         return None
     n = c.n
-    one_section = (isinstance(geo, CylinderOnFlat) and cfg.solver == "elastic"
-                   and cfg.elastic.line_model == "plane-strain")
-    if one_section:
+    if one_section(cfg, geo):
         dx = default / c.n
         n = min(LINE_POINTS_MAX, 2 * math.ceil(need / dx / 2))
         need = n * dx
@@ -329,6 +329,12 @@ def scar_window(cfg: FrettingConfig, geo: Geometry, modulus: float, window: floa
         f"{WINDOW_RADII:g} contact radii, is {default:.4g} m"
         + (", and the load per unit length is kept)" if isinstance(geo, CylinderOnFlat)
            else ")"))
+
+
+def one_section(cfg: FrettingConfig, geo: Geometry) -> bool:
+    """Whether the solver solves the line contact on one cross-section (grids [n, 1])."""
+    return (isinstance(geo, CylinderOnFlat) and cfg.solver == "elastic"
+            and cfg.elastic.line_model == "plane-strain")
 
 
 def contact_half_size(cfg: FrettingConfig, geo: Geometry, modulus: float,
@@ -369,10 +375,14 @@ def check_window(case: FrettingCase) -> None:
     stroke (the lower track grid covers the stroke separately), so the window must hold the
     contact, width 2 a, with a margin of a on each side for the periodic images and the
     contact's growth with wear: window >= 4 a, along every direction in which the contact
-    can reach an edge (a line contact, periodic along y by design: x only). Height maps:
-    the maps must cover the window (and the lower one the stroke); the contact itself is
-    checked by a solve (:func:`check_solved_window`).
+    can reach an edge (a line contact, periodic along y by design: x only); and its spacing
+    window / n must resolve the contact: at most a (a contact of a node or two is no
+    solution; also for a window sized for the scar). The memory the run's arrays need is
+    checked first (:func:`check_allocations`). Height maps: the maps must cover the window
+    (and the lower one the stroke); the contact itself is checked by a solve
+    (:func:`check_solved_window`).
     """
+    check_allocations(case)
     c = case.config.contact
     geo = case.geometry
     if isinstance(geo, HeightMaps):
@@ -388,18 +398,70 @@ def check_window(case: FrettingCase) -> None:
                     f") needs +-{need:.4g} m; allowed: a larger map or a smaller "
                     "contact.window")
         return
-    if c.window is None:
-        return
     assert case.half_size is not None
     what, a = case.half_size
     low = MIN_WINDOW_RADII * a
-    if c.window < low:
+    if c.window is not None and c.window < low:
         along = " along x (a line contact is periodic along y)" if geo.contact == "line" else ""
         raise ConfigError(
             f"contact.window = {c.window!r} m cannot hold the contact: {what} = {a:.4g} m; "
             f"allowed: >= {low:.4g} m ({MIN_WINDOW_RADII:g} a{along}; the window travels with "
             f"the upper body, so the stroke does not enter), or leave it out for "
             f"{WINDOW_RADII:g} a")
+    n = case.contact_case.n
+    window = case.window if case.window is not None else WINDOW_RADII * a
+    if window / n > a:  # a contact of a node or two: the normal solve cannot resolve it
+        given = (f"contact.window = {c.window!r} m" if c.window is not None else
+                 f"the window ({window:.4g} m, {case.window_reason}; contact.window left out)")
+        raise ConfigError(
+            f"{given} does not resolve the contact: its spacing window / n = "
+            f"{window / n:.4g} m (n = {n} points) is larger than the contact's radius: "
+            f"{what} = {a:.4g} m; allowed: a spacing of at most a (contact.window <= "
+            f"{a * n:.4g} m, or a larger contact.n)")
+
+
+#: bytes per cell of the lower body's track grid: the loop's maps (cumulative wear, the
+#: last cycle's increment, the pressure at the loading position), the criterion's depth
+#: maps and the states a jump strategy keeps
+TRACK_CELL_BYTES = 16 * 8
+#: bytes per recorded cycle (its row of results.csv and its jump record, held in memory)
+ROW_BYTES = 1024.0
+
+
+def check_allocations(case: FrettingCase) -> None:
+    """Refuse (``ConfigError`` naming the field) a run whose arrays would not fit in the
+    memory this machine has (:func:`tribodem.io.runs.check_memory`), before any work: the
+    lower body's track grid (the window plus twice ``contact.amplitude`` at the window's
+    spacing; a window left out: 10 contact radii, as the solver sizes it), the cycles'
+    rows and, for a rate criterion with the debris third body, the particles its
+    predicted worn volume makes (:func:`worn_areas`, gross slip: an upper bound)."""
+    cfg = case.config
+    c = cfg.contact
+    n = case.contact_case.n
+    window = case.window if case.window is not None else WINDOW_RADII * case.hertz_radius
+    if window > 0:
+        dx = window / n
+        ny = 1 if one_section(cfg, case.geometry) else n
+        cells = (n + 2.0 * (c.amplitude / dx + 2.0)) * ny
+        fits = runs.available_memory() * 0.8 / TRACK_CELL_BYTES / ny  # cells along x
+        runs.check_memory(
+            cells, TRACK_CELL_BYTES, "contact.amplitude", given=f"{c.amplitude!r} m",
+            what=f"the lower body's track grid cells (the window, {window:.4g} m, plus "
+                 f"twice the amplitude at the window's spacing {dx:.4g} m, x {ny} points)",
+            allowed=f"an amplitude of at most about {max(0.0, fits - n) * dx / 2:.4g} m on "
+                    "this window")
+    runs.check_memory(cfg.cycles, ROW_BYTES, "cycles")
+    areas = worn_areas(cfg, case.load, cfg.cycles) if cfg.debris.every is not None else None
+    if areas is not None:
+        d = cfg.debris
+        spheres = sum(share * debris_template(shape, d.diameter).radii.size
+                      for share, shape in zip(d.shares, SHAPES, strict=True))
+        count = particle_count(sum(areas), d.diameter, d.volume_correction)
+        runs.check_memory(
+            count, spheres * BYTES_PER_PARTICLE, "debris.diameter", given=f"{d.diameter!r} m",
+            what=f"the debris particles the predicted worn volume makes over {cfg.cycles} "
+                 f"cycles ({sum(areas):.3g} m^3, gross slip)",
+            allowed="a larger debris.diameter, fewer cycles, or a smaller wear coefficient")
 
 
 def check_solved_window(case: FrettingCase, solver: FirstBodySolver) -> None:

@@ -33,13 +33,14 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from tribodem.fretting.case import check_compatible
+from tribodem.fretting.case import WINDOW_RADII, FrettingCase, check_compatible
 from tribodem.fretting.config import (
     RESUME_MAY_CHANGE,
     FrettingConfig,
     resolve_config,
     runs_ccx,
 )
+from tribodem.fretting.criteria import CRITERIA
 from tribodem.fretting.output import CHECKPOINT
 from tribodem.fretting.record import read_study, study_diffs
 from tribodem.fretting.runner import Echo, run
@@ -73,6 +74,18 @@ SEED_CONCLUSION = ("von Mises and S22 grossly over-predict, equivalent plastic s
                    "near 1000 cycles, the shear criterion fits the experiment best")
 
 
+#: ``--quick`` on a backend without plastic strain: the stage whose criterion needs it (DFDI)
+#: runs on the backend's plastic counterpart (the same half-space with EPIC plasticity), so
+#: the quick study runs every stage; the full study skips it, with the reason
+QUICK_PLASTIC_COUNTERPART = {"elastic": "elastic-plastic"}
+#: ``--quick``: the window of a multi-cycle threshold stage (shear, shear_jump) of a point
+#: contact, in contact radii of the unworn contact. A rate criterion's window is sized for
+#: the scar it predicts (``fretting.case.scar_window``); a threshold criterion's scar is not
+#: known in advance, and on the 64^2 quick window of the default 10 radii the 15-cycle
+#: shear_jump stage outgrew it at cycle 12 (exit 3); at 20 radii it holds the 15 cycles
+QUICK_THRESHOLD_WINDOW_RADII = 2.0 * WINDOW_RADII
+
+
 @dataclass(frozen=True)
 class Stage:
     """One fretting run of the study."""
@@ -101,6 +114,36 @@ def stage_config(cfg: FrettingConfig, st: Stage) -> FrettingConfig:
         "debris": cfg.debris.model_copy(update={"every": None})})
 
 
+def quick_stage(scfg: FrettingConfig, st: Stage) -> tuple[FrettingConfig, dict[str, Any]]:
+    """A stage's config under ``--quick`` (:data:`QUICK_PLASTIC_COUNTERPART`,
+    :data:`QUICK_THRESHOLD_WINDOW_RADII`) and what changed, for its row (``solver`` and
+    ``quick_note``; empty when nothing did)."""
+    notes: dict[str, Any] = {}
+    other = QUICK_PLASTIC_COUNTERPART.get(scfg.solver)
+    if other is not None:
+        try:
+            check_compatible(scfg)
+        except ConfigError:
+            swapped = scfg.model_copy(update={"solver": other})
+            check_compatible(swapped)  # the counterpart serves it, or the stage is skipped
+            notes["solver"] = other
+            notes["quick_note"] = (f"--quick: run on solver {other!r} ({scfg.solver!r} gives "
+                                   f"no plastic strain, which {st.criterion} needs)")
+            scfg = swapped
+    if (scfg.contact.window is None and st.cycles > 1
+            and CRITERIA[st.criterion].kind == "threshold"):
+        case = FrettingCase.of(scfg)
+        if case.contact != "line" and case.hertz_radius > 0:
+            window = QUICK_THRESHOLD_WINDOW_RADII * case.hertz_radius
+            scfg = scfg.model_copy(update={"contact": scfg.contact.model_copy(
+                update={"window": window})})
+            notes["quick_note"] = (
+                f"--quick: window {window:.4g} m ({QUICK_THRESHOLD_WINDOW_RADII:g} contact "
+                f"radii, {scfg.contact.n} points: a threshold criterion's scar is not known "
+                "in advance)")
+    return scfg, notes
+
+
 def row_of(st: Stage, summary: dict[str, Any]) -> dict[str, Any]:
     """The study's numbers of one finished stage (from its summary.json)."""
     crit = summary.get("criterion_last_cycle", {})
@@ -117,6 +160,8 @@ def row_of(st: Stage, summary: dict[str, Any]) -> dict[str, Any]:
     }
     if summary.get("jump", {}).get("reading"):  # what limited the jumps (FrettingLoop)
         row["jump_reading"] = summary["jump"]["reading"]
+    if summary.get("wear_zero_reason"):  # nothing worn: why (fretting.output)
+        row["wear_zero_reason"] = summary["wear_zero_reason"]
     # a stage stopped before its first cycle measured nothing (not a zero rate)
     row["mean_scar_depth_per_cycle_lower_m"] = (row["mean_scar_depth_lower_m"] / n if n > 0
                                                 else None)
@@ -198,6 +243,9 @@ def write_markdown(out: Path, rows: list[dict[str, Any]], table: list[dict[str, 
             f"{r['wall_time_s']:.1f} |")
     lines += [f"\n{r['stage']}, cycle-jumping: {r['jump_reading']}." for r in rows
               if r.get("jump_reading")]
+    lines += [f"\n{r['stage']}: {r['quick_note']}." for r in rows if r.get("quick_note")]
+    lines += [f"\n{r['stage']}, nothing worn: {r['wear_zero_reason']}." for r in rows
+              if r.get("wear_zero_reason")]
     lines += [f"\n{r['stage']}: cycle(s) {_spans(r['softened_cycles'])} of "
               f"{r['cycles']} converged only on a softened contact (penalty x "
               f"{r['softest_penalty_scale']:g} at the softest; a softer contact wears less: "
@@ -346,7 +394,7 @@ def run_study(cfg: FrettingConfig, out: Path, quick: bool = False, resume: bool 
     done: dict[str, Path] = {}
     for k, st in enumerate(plan):
         row = run_stage(cfg, st, out, f"stage {k + 1}/{len(plan)}", resume=resume,
-                        progress=progress, echo=echo)
+                        progress=progress, echo=echo, quick=quick)
         rows.append(row)
         if not row.get("skipped"):
             done[st.name] = out / st.name
@@ -354,12 +402,19 @@ def run_study(cfg: FrettingConfig, out: Path, quick: bool = False, resume: bool 
 
 
 def run_stage(cfg: FrettingConfig, st: Stage, out: Path, label: str, *, resume: bool,
-              progress: bool, echo: Echo | None) -> dict[str, Any]:
+              progress: bool, echo: Echo | None, quick: bool = False) -> dict[str, Any]:
     """One stage into ``out/<stage>/`` (kept when it finished before and ``resume``;
-    skipped when its criterion needs what the backend lacks): its row (:func:`row_of`,
-    with ``skipped`` or ``stopped`` saying why)."""
+    skipped when its criterion needs what the backend lacks; ``quick``:
+    :func:`quick_stage`): its row (:func:`row_of`, with ``skipped`` or ``stopped`` saying
+    why)."""
     say = echo or (lambda s: None)
     scfg = stage_config(cfg, st)
+    notes: dict[str, Any] = {}
+    if quick:
+        try:
+            scfg, notes = quick_stage(scfg, st)
+        except ConfigError:  # no counterpart serves it either: skipped below, with the reason
+            pass
     if scfg.fe.cache is None and runs_ccx(scfg.solver):
         # the one-cycle stages run the same first-body job: run it once
         scfg = scfg.model_copy(update={"fe": scfg.fe.model_copy(
@@ -376,8 +431,9 @@ def run_stage(cfg: FrettingConfig, st: Stage, out: Path, label: str, *, resume: 
     stopped = None
     if not finished:
         jumping = f" with {st.jump} jumping" if st.jump != "none" else ""
+        note = f" ({notes['quick_note']})" if notes.get("quick_note") else ""
         say(f"{label} {st.name}: criterion {st.criterion}, "
-            f"{st.cycles} cycle(s){jumping} -> {folder}")
+            f"{st.cycles} cycle(s){jumping}{note} -> {folder}")
         try:
             run(scfg, folder, resume=resume and (folder / CHECKPOINT).is_file(),
                 progress=progress, echo=echo)
@@ -386,7 +442,7 @@ def run_stage(cfg: FrettingConfig, st: Stage, out: Path, label: str, *, resume: 
             say(f"  {st.name} stopped early: {err}")
         runs.announce(out, folder / CHECKPOINT, resume_hint="add --resume to the same "
                       "command")
-    row = row_of(st, json.loads(summary_path.read_text()))
+    row = {**row_of(st, json.loads(summary_path.read_text())), **notes}
     if stopped is not None or row["cycles"] < st.cycles:
         row["stopped"] = stopped if stopped is not None else f"stopped at cycle {row['cycles']}"
     return row

@@ -21,14 +21,16 @@ from tribodem.fretting.runner import run
 from tribodem.fretting.table_sweep import sweep
 from tribodem.io import runs
 from tribodem.io.config import ConfigError
+from tribodem.io.helptext import reflowed
 
-fretting_app = typer.Typer(help="Fretting wear loop (seed 003 chapters 5-6).",
+fretting_app = typer.Typer(help="Fretting wear loop (Lu 2018, PhD thesis, Exeter: chapters "
+                                "5-6).",
                            no_args_is_help=True, add_completion=False)
 
 
 @fretting_app.callback()
 def _fretting() -> None:
-    """Fretting wear loop (seed 003 chapters 5-6)."""
+    """Fretting wear loop (Lu 2018, PhD thesis, Exeter: chapters 5-6)."""
 
 
 def run_overrides(criterion: str | None, cycles: int | None, jump: str | None,
@@ -63,6 +65,7 @@ def run_overrides(criterion: str | None, cycles: int | None, jump: str | None,
 
 
 @fretting_app.command("run")
+@reflowed
 def run_cmd(
     out: Annotated[Path, typer.Option("--out", help="Output directory.")],
     config: Annotated[Path | None, typer.Option("--config", help="TOML config file.")] = None,
@@ -100,15 +103,17 @@ def run_cmd(
 
 
 @fretting_app.command("study")
+@reflowed
 def study_cmd(
     out: Annotated[Path, typer.Option("--out", help="Output directory.")],
     config: Annotated[Path | None, typer.Option(
-        "--config", help="TOML config of the case (default: the seed's crossed cylinders; "
+        "--config", help="TOML config of the case (default: the thesis's crossed cylinders; "
         "its criterion, cycles and jumping are the study's).")] = None,
     solver: Annotated[str | None, typer.Option(
         "--solver", help=f"First-body backend: {', '.join(BACKENDS)}.")] = None,
     quick: Annotated[bool, typer.Option(
-        "--quick", help="64^2 grid, 5 and 15 cycles instead of 30 and 110.")] = False,
+        "--quick", help="64^2 grid, 5 and 15 cycles instead of 30 and 110 (a fast check, "
+        "not the thesis's numbers).")] = False,
     stages: Annotated[str | None, typer.Option(
         "--stages", help="Comma-separated stages to run (default all: von_mises,s22,dfdi,"
         "swt,shear,energy,shear_jump).")] = None,
@@ -120,9 +125,14 @@ def study_cmd(
     progress: Annotated[bool, typer.Option(
         "--progress/--no-progress", help="Progress bars of the runs on stderr.")] = True,
 ) -> None:
-    """Seed 003 chapter 6: every material evolution criterion on one case (one cycle for
-    von Mises, S22, DFDI, SWT; 30 for shear and energy; shear with jumping to 110), the
-    seed's numbers beside ours and the criteria ordered (study.md, study.json)."""
+    """The criteria study of Lu 2018 (thesis chapter 6): every material evolution criterion
+    on one case (one cycle for von Mises, S22, DFDI, SWT; 30 for shear and energy; shear
+    with jumping to 110), the thesis's numbers beside ours and the criteria ordered
+    (study.md, study.json).
+
+    With --quick on the elastic half-space the DFDI stage runs on its elastic-plastic
+    counterpart (DFDI needs the plastic strain), and the multi-cycle threshold stages get a
+    window twice the default."""
     ov = {"fe": {"threads": threads}} if threads is not None else None
     summary = study(config, out, quick=quick, resume=resume, progress=progress,
                     solver=solver, stages=stages, overrides=ov, echo=typer.echo).summary
@@ -131,12 +141,13 @@ def study_cmd(
 
 
 @fretting_app.command("debris-study")
+@reflowed
 def debris_study_cmd(
     out: Annotated[Path, typer.Option("--out", help="Output directory.")],
     config: Annotated[Path | None, typer.Option(
         "--config", help="TOML config of the case (default: the energy case).")] = None,
     counts: Annotated[str | None, typer.Option(
-        "--counts", help="Debris particle counts (default: the seed's 22000,81000,102000; "
+        "--counts", help="Debris particle counts (default: the thesis's 22000,81000,102000; "
         f"--quick: {','.join(str(c) for c in QUICK_STUDY_COUNTS)}).")] = None,
     cycle: Annotated[int | None, typer.Option(
         "--cycle", help="Cycle of the study (default: config cycles, 160).")] = None,
@@ -149,8 +160,9 @@ def debris_study_cmd(
     progress: Annotated[bool, typer.Option(
         "--progress/--no-progress", help="Progress bar of the wear run on stderr.")] = True,
 ) -> None:
-    """Seed 003 section 5.4: contact force on the lower body at a cycle, without and with N
-    debris particles (figs 5.22-5.27); writes debris_study.{csv,json}, plots, per-count data."""
+    """Debris as a third body (Lu 2018, thesis section 5.4): the contact force on the lower
+    body at a cycle, without and with N debris particles (thesis figs 5.22-5.27); writes
+    debris_study.{csv,json}, plots, per-count data."""
     summary = debris_study(config, out, counts=counts, cycle=cycle, quick=quick,
                            resume=resume, progress=progress, threads=threads,
                            echo=typer.echo).summary
@@ -159,6 +171,7 @@ def debris_study_cmd(
 
 
 @fretting_app.command("sweep")
+@reflowed
 def sweep_cmd(
     table: Annotated[Path, typer.Option(
         "--table", help="CSV table: a header of config fields in dotted form (contact.load, "

@@ -14,6 +14,7 @@ from typing import Any, ClassVar, Literal
 
 from pydantic import (
     Field,
+    ValidationError,
     ValidationInfo,
     field_validator,
     model_validator,
@@ -22,11 +23,11 @@ from pydantic import (
 from tribodem.contact import BACKENDS, FirstBodySolver
 from tribodem.contact.fe.options import FEOptions
 from tribodem.contact.geometry import CrossedCylinders, CylinderOnFlat, FlatPunch, SphereOnFlat
-from tribodem.contact.options import ElasticOptions, PlasticOptions
+from tribodem.contact.options import STRENGTH_RANGE, ElasticOptions, PlasticOptions
 from tribodem.fretting.criteria import ALPHA_SEED, ARCHARD_K, UTS_EN24T, YIELD_EN24T
 from tribodem.fretting.loop import GEOMETRY_TOLERANCE
-from tribodem.io.config import ConfigError, merge
-from tribodem.io.model import StrictModel
+from tribodem.io.config import ConfigError, format_validation_error, merge
+from tribodem.io.model import PhysicalConfig, StrictModel, physical
 from tribodem.io.record import (
     ConfigSource,
     Source,
@@ -57,6 +58,15 @@ GEOMETRY_FIELDS: dict[str, tuple[str, ...]] = {
 }
 _ALL_GEOMETRY_FIELDS = tuple(dict.fromkeys(f for fs in GEOMETRY_FIELDS.values() for f in fs))
 
+#: Physical ranges (real materials and rigs) of the fields that share them (SI units; the
+#: strengths' STRENGTH_RANGE, Pa, is the [plastic] table's).
+YOUNG_RANGE = (1e6, 2e12)  #: Young's moduli, Pa: soft elastomers to diamond x 2
+RADIUS_RANGE = (1e-6, 10.0)  #: radii of curvature, m: an AFM tip to a large roller
+DIAMETER_RANGE = (2e-6, 20.0)  #: diameters, m (2 x RADIUS_RANGE)
+FRICTION_RANGE = (0.0, 5.0)  #: friction coefficients: lubricated to clean metals in vacuum
+WEAR_COEFFICIENT_RANGE = (0.0, 1e-9)  #: Archard k, 1/Pa, and energy alpha, m^3/J (the
+#: seed's alpha 1.6e-15: severe wear of the softest materials stays below 1e-11)
+
 #: Default total normal load on the window, N (DESIGN.md default case).
 DEFAULT_LOAD = 100.0
 
@@ -74,43 +84,56 @@ class ContactConfig(StrictModel):
 
     geometry: GeometryName = "crossed_cylinders"
     diameter: float | None = Field(
-        None, gt=0, description="crossed_cylinders: both cylinders' diameter, m (shorthand for "
-        "radius_upper = radius_lower = diameter / 2; a radius given wins)")
-    radius_upper: float | None = Field(None, gt=0, description="crossed_cylinders: upper "
-                                       "cylinder's radius (axis along y), m")
-    radius_lower: float | None = Field(None, gt=0, description="crossed_cylinders: lower "
-                                       "cylinder's radius (axis along x), m")
-    radius: float | None = Field(None, gt=0, description="sphere_on_flat / cylinder_on_flat: "
-                                 "radius of the upper body, m")
-    punch_radius: float | None = Field(None, gt=0, description="flat_punch: radius of the "
-                                       "flat face, m")
-    edge_radius: float | None = Field(None, gt=0, description="flat_punch: edge radius, m")
+        None, gt=0, **physical(*DIAMETER_RANGE, "m", "crossed_cylinders: both cylinders' "
+                               "diameter, m (shorthand for radius_upper = radius_lower = "
+                               "diameter / 2; a radius given wins)"))
+    radius_upper: float | None = Field(None, gt=0, **physical(
+        *RADIUS_RANGE, "m", "crossed_cylinders: upper cylinder's radius (axis along y), m"))
+    radius_lower: float | None = Field(None, gt=0, **physical(
+        *RADIUS_RANGE, "m", "crossed_cylinders: lower cylinder's radius (axis along x), m"))
+    radius: float | None = Field(None, gt=0, **physical(
+        *RADIUS_RANGE, "m", "sphere_on_flat / cylinder_on_flat: radius of the upper body, m"))
+    punch_radius: float | None = Field(None, gt=0, **physical(
+        *RADIUS_RANGE, "m", "flat_punch: radius of the flat face, m"))
+    edge_radius: float | None = Field(None, gt=0, **physical(
+        *RADIUS_RANGE, "m", "flat_punch: edge radius, m"))
     upper_map: str | None = Field(None, description="height_map: upper body's surface "
                                   "heights (.csv, .npy with map_dx; .stl)")
     lower_map: str | None = Field(None, description="height_map: lower body's surface "
                                   "heights (must cover the window plus the stroke along x)")
-    map_dx: float | None = Field(None, gt=0, description="height_map: grid spacing of CSV/NPY "
-                                 "maps (STL: sampling step, default its vertex spacing), m")
-    load: float | None = Field(None, gt=0, description="total normal load on the window, N "
-                               "(default 100 N; line contact: or load_per_length)")
-    load_per_length: float | None = Field(
-        None, gt=0, description="cylinder_on_flat: normal load per unit length of the "
-        "cylinder, N/m (instead of the total load over the window)")
-    friction: float = Field(0.6, ge=0, description="friction coefficient")
-    amplitude: float = Field(0.3e-3, gt=0, description="displacement amplitude, m")
-    n_increments: int = Field(48, ge=4, description="increments per cycle (multiple of 4)")
+    map_dx: float | None = Field(None, gt=0, **physical(
+        1e-9, 1.0, "m", "height_map: grid spacing of CSV/NPY maps (STL: sampling step, "
+        "default its vertex spacing), m"))
+    load: float | None = Field(None, gt=0, **physical(
+        1e-6, 1e6, "N", "total normal load on the window, N (default 100 N; line contact: "
+        "or load_per_length)"))
+    load_per_length: float | None = Field(None, gt=0, **physical(
+        1e-3, 1e8, "N/m", "cylinder_on_flat: normal load per unit length of the cylinder, "
+        "N/m (instead of the total load over the window)"))
+    friction: float = Field(0.6, ge=0, **physical(*FRICTION_RANGE, "",
+                                                  "friction coefficient"))
+    amplitude: float = Field(0.3e-3, gt=0, **physical(
+        1e-9, 0.1, "m", "displacement amplitude, m (the lower body's track grid spans the "
+        "window plus twice the amplitude at the window's spacing, and must fit in memory)"))
+    n_increments: int = Field(48, ge=4, le=100_000,
+                              description="increments per cycle (multiple of 4)")
     regime: Literal["gross", "ciavarella-jaeger"] = "gross"
     n: int = Field(256, ge=16, le=2048, description="window points per side (even)")
-    window: float | None = Field(None, gt=0, description="window side, m (None: 10 radii)")
+    window: float | None = Field(None, gt=0, **physical(
+        1e-8, 1.0, "m", "window side, m (None: 10 radii; it must hold 4 contact radii and "
+        "resolve the contact: a spacing window / n of at most a contact radius)"))
     tolerance: float = Field(1e-6, gt=0, lt=1, description="normal solver (PKR) tolerance")
-    young: float = Field(EN24T.young, gt=0, description="Young's modulus (both bodies unless "
-                         "young_upper / young_lower), Pa")
+    young: float = Field(EN24T.young, gt=0, **physical(
+        *YOUNG_RANGE, "Pa", "Young's modulus (both bodies unless young_upper / young_lower), "
+        "Pa"))
     poisson: float = Field(EN24T.poisson, gt=-1, lt=0.5, description="Poisson's ratio (both "
                            "bodies unless poisson_upper / poisson_lower)")
-    young_upper: float | None = Field(None, gt=0, description="upper body's Young's modulus, Pa")
+    young_upper: float | None = Field(None, gt=0, **physical(
+        *YOUNG_RANGE, "Pa", "upper body's Young's modulus, Pa"))
     poisson_upper: float | None = Field(None, gt=-1, lt=0.5, description="upper body's "
                                         "Poisson's ratio")
-    young_lower: float | None = Field(None, gt=0, description="lower body's Young's modulus, Pa")
+    young_lower: float | None = Field(None, gt=0, **physical(
+        *YOUNG_RANGE, "Pa", "lower body's Young's modulus, Pa"))
     poisson_lower: float | None = Field(None, gt=-1, lt=0.5, description="lower body's "
                                         "Poisson's ratio")
 
@@ -186,18 +209,25 @@ class WearConfig(StrictModel):
     """Criterion and its parameters (SI)."""
 
     criterion: CriterionName = "energy"
-    alpha: float = Field(ALPHA_SEED, ge=0, description="energy wear coefficient, m^3/J")
+    alpha: float = Field(ALPHA_SEED, ge=0, **physical(
+        *WEAR_COEFFICIENT_RANGE, "m^3/J", "energy wear coefficient, m^3/J"))
     energy_share_upper: float = Field(
         0.5, ge=0, le=1, description="energy: upper body's share of eq 2.7's total volume")
-    archard_k_upper: float = Field(ARCHARD_K, ge=0, description="Archard k, upper body, 1/Pa")
-    archard_k_lower: float = Field(ARCHARD_K, ge=0, description="Archard k, lower body, 1/Pa")
-    yield_strength: float = Field(YIELD_EN24T, gt=0, description="Pa (s22, von_mises)")
-    uts: float = Field(UTS_EN24T, gt=0, description="Pa (shear: S_us = 0.8 UTS)")
-    stress_depth: float | None = Field(None, gt=0, description="subsurface grid depth, m")
+    archard_k_upper: float = Field(ARCHARD_K, ge=0, **physical(
+        *WEAR_COEFFICIENT_RANGE, "1/Pa", "Archard k, upper body, 1/Pa"))
+    archard_k_lower: float = Field(ARCHARD_K, ge=0, **physical(
+        *WEAR_COEFFICIENT_RANGE, "1/Pa", "Archard k, lower body, 1/Pa"))
+    yield_strength: float = Field(YIELD_EN24T, gt=0, **physical(
+        *STRENGTH_RANGE, "Pa", "yield strength, Pa (s22, von_mises)"))
+    uts: float = Field(UTS_EN24T, gt=0, **physical(
+        *STRENGTH_RANGE, "Pa", "ultimate tensile strength, Pa (shear: S_us = 0.8 UTS)"))
+    stress_depth: float | None = Field(None, gt=0, **physical(
+        1e-9, 1.0, "m", "subsurface grid depth, m"))
     stress_nz: int = Field(33, ge=2, le=257, description="subsurface grid levels")
     stress_samples: int = Field(8, ge=1, description="sampled increments per cycle")
-    eps0: float = Field(EN24T.dfdi_eps0, gt=0, description="dfdi: uniaxial failure strain "
-                        "eps0 (eq 6.2; default the seed's script's, appendix IV)")
+    eps0: float = Field(EN24T.dfdi_eps0, gt=0, **physical(
+        1e-4, 10.0, "", "dfdi: uniaxial failure strain eps0 (eq 6.2; default the seed's "
+        "script's, appendix IV)"))
     dfdi_triaxiality: Literal["local", "seed-script"] = Field(
         "local", description="dfdi: eq 6.2's sigma_m / sigma_eq per point (local), or as the "
         "seed's script computes it (ranges over the cycle, sigma_eq summed over all nodes: "
@@ -221,13 +251,18 @@ class DebrisConfig(StrictModel):
     """The debris third body (seed 003 3.2.6-3.2.7); off unless ``every`` is set."""
 
     every: int | None = Field(None, ge=1, description="DE phase every K cycles (None: off)")
-    diameter: float = Field(0.6e-6, gt=0, description="debris diameter d of eq 3.10, m")
+    diameter: float = Field(0.6e-6, gt=0, **physical(
+        1e-7, 1e-3, "m", "debris diameter d of eq 3.10, m (the particles a run makes, worn "
+        "volume / (pi d^3 / 6), must fit in memory)"))
     shares: tuple[float, float, float] = Field(
         (1 / 3, 1 / 3, 1 / 3), description="spherical, chunk, rubbing fractions")
     volume_correction: float = Field(1.0, gt=0, le=2, description="seed's 0.77 (optional)")
     cor: float = Field(0.72, gt=0, le=1)
-    friction: float = Field(0.6, ge=0)
-    rolling_friction: float = Field(0.001, ge=0)
+    friction: float = Field(0.6, ge=0, **physical(
+        *FRICTION_RANGE, "", "sliding friction coefficient of the debris contacts"))
+    rolling_friction: float = Field(0.001, ge=0, **physical(
+        0.0, 1.0, "", "rolling friction coefficient of the debris contacts (constant "
+        "torque)"))
     density_scaling: float = Field(1.0, ge=1, description="DE-phase mass scaling")
     tolerance: float = Field(1e-4, gt=0, lt=0.1, description="servo relative load error")
     max_steps: int = Field(200_000, ge=100, description="DE steps per phase at most")
@@ -281,7 +316,7 @@ QUICK_SOLVER: dict[str, dict[str, Any]] = {
              "fe": {"h_over_a": 1.0, "size_factor": 10.0, "cycle_increments": 64}}}
 
 
-class FrettingConfig(StrictModel):
+class FrettingConfig(PhysicalConfig):
     """``tribodem fretting run`` configuration (TOML tables contact, wear, jump, plastic, fe,
     debris, output)."""
 
@@ -299,10 +334,36 @@ class FrettingConfig(StrictModel):
     fe: FEOptions = Field(default_factory=FEOptions)
     debris: DebrisConfig = Field(default_factory=DebrisConfig)
     output: OutputConfig = Field(default_factory=OutputConfig)
+    #: the option tables of backends registered beside the built-in ones (a plug-in
+    #: backend's own ``[name]`` table, from its ``FirstBodySolver.options``), each checked
+    #: by the backend's model and written back as a table of its own
+    plugin_options: dict[str, dict[str, Any]] = Field(default_factory=dict, exclude=True)
 
     #: the ``--quick`` presets (:data:`QUICK`, per backend :data:`QUICK_SOLVER`)
     QUICK: ClassVar[dict[str, Any]] = QUICK
     QUICK_SOLVER: ClassVar[dict[str, dict[str, Any]]] = QUICK_SOLVER
+
+    @model_validator(mode="before")
+    @classmethod
+    def _plugin_tables(cls, data: Any) -> Any:
+        """Move the top-level tables that a registered backend reads but this model does
+        not declare into :attr:`plugin_options`, each validated by the backend's model
+        (``ValueError`` naming ``table.field``)."""
+        if not isinstance(data, dict):
+            return data
+        models = {t: m for b in BACKENDS.values() for t, m in b.options.items()
+                  if t not in cls.model_fields}
+        found = [k for k in data if k in models]
+        if not found:
+            return data
+        plugin = dict(data.get("plugin_options") or {})
+        for k in found:
+            try:
+                plugin[k] = models[k].model_validate(data[k]).model_dump(mode="json")
+            except ValidationError as err:
+                raise ValueError(format_validation_error(err, k).replace(
+                    f"{k}: field '", f"{k}.").replace("' = ", " = ")) from None
+        return {**{k: v for k, v in data.items() if k not in found}, "plugin_options": plugin}
 
     @field_validator("solver")
     @classmethod
@@ -326,8 +387,8 @@ class FrettingConfig(StrictModel):
     def record(self) -> dict[str, Any]:
         """This config as JSON-able nested dicts, as it is recorded (config.toml,
         summary.json, the checkpoint, study.toml): every field, in its JSON form ('off' for
-        no slope limit)."""
-        return self.model_dump(mode="json")
+        no slope limit), a plug-in backend's table among the others."""
+        return {**self.model_dump(mode="json"), **self.plugin_options}
 
 
 #: The option tables beside ``[contact]`` that backends read (each backend its own,
@@ -348,8 +409,11 @@ def runs_ccx(solver: str | None) -> bool:
 
 def option_tables(cfg: FrettingConfig) -> dict[str, Any]:
     """The option tables the configured backend reads (``FirstBodySolver.options``), by
-    TOML name, as :meth:`~tribodem.contact.FirstBodySolver.from_case` takes them."""
-    return {t: getattr(cfg, t) for t in BACKENDS[cfg.solver].options}
+    TOML name, as :meth:`~tribodem.contact.FirstBodySolver.from_case` takes them (a
+    plug-in backend's own table from :attr:`FrettingConfig.plugin_options`)."""
+    return {t: getattr(cfg, t) if t in FrettingConfig.model_fields
+            else model.model_validate(cfg.plugin_options.get(t, {}))
+            for t, model in BACKENDS[cfg.solver].options.items()}
 
 
 def read_config(config: ConfigSource) -> Source:

@@ -29,6 +29,7 @@ dissipates is not counted as first-body wear.
 
 from __future__ import annotations
 
+import logging
 import math
 import time
 from dataclasses import asdict, dataclass, field
@@ -49,6 +50,10 @@ from tribodem.dem.clumps import (
 )
 from tribodem.dem.surfaces import HeightMapSurface, bilinear_weights
 from tribodem.materials.en24t import EN24T
+
+log = logging.getLogger(__name__)
+#: seconds between two notes of a DE phase's progress (INFO: a phase takes minutes)
+DE_NOTE_EVERY_S = 20.0
 
 SHAPES = DEBRIS_SHAPES  # spherical, chunk, rubbing (seed figure 3.6; tribodem.dem.clumps)
 
@@ -422,6 +427,9 @@ def run_de_phase(field: DebrisField, lower: NDArray[np.float64], gap: NDArray[np
     sim.add_interaction(upper_s)
     hist: list[tuple[float, float, float, float]] = []
     converged = False
+    log.debug("DE phase (cycle %d): %d debris bodies (%d members), target %.4g N, at most %d "
+              "steps", cycle, ia.size, p.n, target, s.max_steps)
+    noted = time.perf_counter()
     while sim.step_count < s.max_steps:
         k = upper_s.stiffness
         ramp = min(1.0, (sim.step_count + chunk) / max(s.ramp_steps, 1))
@@ -434,6 +442,11 @@ def run_de_phase(field: DebrisField, lower: NDArray[np.float64], gap: NDArray[np
         if err < s.tolerance and abs(upper_s.velocity[2]) * sim.dt < 1e-6 * r:
             converged = True
             break
+        if time.perf_counter() - noted > DE_NOTE_EVERY_S:
+            noted = time.perf_counter()
+            log.info("DE phase (cycle %d, %d debris bodies): step %d of at most %d, servo "
+                     "force error %.3g (converged below %.3g)", cycle, ia.size,
+                     sim.step_count, s.max_steps, err, s.tolerance)
     pf = lower_s.particle_force.copy()
     # force the members push the lower body down with, N; a separating contact's dashpot can
     # pull (the Hertz-Mindlin law is not clipped, as in LIGGGHTS): a contact cannot hold the

@@ -33,7 +33,7 @@ from numpy.typing import NDArray
 
 from tribodem.dem.clumps import debris_template
 from tribodem.dem.state import BYTES_PER_PARTICLE
-from tribodem.fretting.case import FrettingCase, build_loop, debris_settings
+from tribodem.fretting.case import build_loop, debris_settings, preflight
 from tribodem.fretting.config import RESUME_MAY_CHANGE, FrettingConfig, resolve_config
 from tribodem.fretting.debris import (
     SHAPES,
@@ -43,7 +43,7 @@ from tribodem.fretting.debris import (
     run_de_phase,
 )
 from tribodem.fretting.loop import FrettingLoop
-from tribodem.fretting.output import CHECKPOINT, read_checkpoint
+from tribodem.fretting.output import CHECKPOINT, read_checkpoint, write_checkpoint
 from tribodem.fretting.record import read_study, study_diffs
 from tribodem.fretting.runner import Echo, run
 from tribodem.io import runs
@@ -288,20 +288,33 @@ def profiles_csv(out: Path, coords: NDArray[np.float64], p_without: NDArray[np.f
 
 
 def save_count(out: Path, count: int, row: dict[str, Any],
-               arrays: dict[str, NDArray[np.float64]]) -> None:
-    """One count's result (atomically: arrays first, then the row that marks it done)."""
+               arrays: dict[str, NDArray[np.float64]], solver_state: dict[str, Any]) -> None:
+    """One count's result, atomically: its arrays, then the first-body solver's state after
+    it (the warm starts the next count's solves begin from: a resumed study restores it,
+    so its next count is bitwise the uninterrupted study's), then the row that marks it
+    done."""
     write_npz(out / f"count_{count:06d}.npz", **arrays)
+    write_checkpoint(out / f"count_{count:06d}_state.npz", {"count": int(count)},
+                     solver_state)
     write_json(out / f"count_{count:06d}.json", row)
 
 
-def load_count(out: Path, count: int) -> tuple[dict[str, Any], dict[str, NDArray]] | None:
-    """A count finished by an earlier run of the study, or None."""
+def load_count(out: Path, count: int
+               ) -> tuple[dict[str, Any], dict[str, NDArray], dict[str, Any]] | None:
+    """A count finished by an earlier run of the study: (row, arrays, the solver's state
+    after it), or None (also for a count of an older study without the solver's state: it
+    is run again, so the counts after it start from the same state as uninterrupted)."""
     js, npz = out / f"count_{count:06d}.json", out / f"count_{count:06d}.npz"
-    if not (js.is_file() and npz.is_file()):
+    st = out / f"count_{count:06d}_state.npz"
+    if not (js.is_file() and npz.is_file() and st.is_file()):
+        return None
+    try:
+        state = read_checkpoint(st)[1]
+    except ConfigError:  # cut short or foreign: the count is run again
         return None
     with np.load(npz) as f:
         arrays = {k: f[k] for k in f.files}
-    return json.loads(js.read_text()), arrays
+    return json.loads(js.read_text()), arrays, state
 
 
 def assumptions(cycle: int) -> dict[str, str]:
@@ -382,8 +395,11 @@ def run_debris_study(cfg: FrettingConfig, out: Path, counts: tuple[int, ...] = S
     ``cfg``: a validated :class:`~tribodem.fretting.config.FrettingConfig` (its ``cycles``
     is the study's cycle; its ``[debris]`` table gives the particle settings, its ``every``
     is ignored: the wear run has no debris). Stages, each kept: ``out/wear/`` (the fretting
-    run, with its checkpoint), ``count_NNNNNN.{npz,json}`` per count; ``resume`` skips
-    finished stages and resumes the wear run from its checkpoint.
+    run, with its checkpoint), ``count_NNNNNN.{npz,json}`` per count and
+    ``count_NNNNNN_state.npz``, the first-body solver's state after it (the warm starts of
+    the next count's solves); ``resume`` skips finished stages, restoring the state the
+    last of them left, and resumes the wear run from its checkpoint: the study resumed
+    after any stage is bitwise the uninterrupted one.
     """
     say = echo or (lambda s: None)
     out = Path(out)
@@ -391,7 +407,7 @@ def run_debris_study(cfg: FrettingConfig, out: Path, counts: tuple[int, ...] = S
     ck = wear_dir / CHECKPOINT
     runs.check_out_dir(out, "--out", resume=resume, need=("study.toml",) if resume else ())
     cfg = cfg.model_copy(update={"debris": cfg.debris.model_copy(update={"every": None})})
-    case = FrettingCase.of(cfg)
+    case = preflight(cfg)  # the case and every check of a run before any work
     settings = debris_settings(case)
     check_counts(settings, counts)
     meta = {"config": cfg.record(), "counts": [int(c) for c in counts]}
@@ -487,7 +503,13 @@ def count_stage(loop: FrettingLoop, settings: DebrisSettings, count: int,
     run and saved (``RunStopped`` when it fails: the finished stages are kept)."""
     got = load_count(out, count) if resume else None
     if got is not None:
-        return got
+        row, arrays, state = got
+        try:  # where the uninterrupted study's next count starts from
+            loop.solver.load_state_dict(state)
+        except (KeyError, TypeError, ValueError) as err:
+            raise ConfigError(f"--resume: '{out / f'count_{count:06d}_state.npz'}' does "
+                              f"not fit this study: {type(err).__name__}: {err}") from None
+        return row, arrays
     say(f"{label}: DE phase with {count:,} debris particles")
     try:
         row, arrays = run_count(loop, settings, count, p_without, gap, zones)
@@ -495,5 +517,5 @@ def count_stage(loop: FrettingLoop, settings: DebrisSettings, count: int,
         raise runs.RunStopped(
             f"DE phase with {count:,} particles: {err} (the wear run and the "
             "finished counts are kept; --resume runs the missing counts again)") from None
-    save_count(out, count, row, arrays)
+    save_count(out, count, row, arrays, loop.solver.state_dict())
     return row, arrays

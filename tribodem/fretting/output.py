@@ -37,11 +37,58 @@ def write_rows(hist: FrettingHistory, out: Path) -> Path:
 
 
 def write_results(hist: FrettingHistory, out: Path, extra: dict[str, Any]) -> dict[str, Any]:
-    """``out/results.csv`` (one row per cycle) and ``out/summary.json`` (totals + ``extra``)."""
+    """``out/results.csv`` (one row per cycle) and ``out/summary.json`` (totals + ``extra``,
+    and ``wear_zero_reason``: :func:`wear_zero_reason`)."""
     write_rows(hist, out)
     summary = {**hist.summary(), **extra}
+    summary["wear_zero_reason"] = wear_zero_reason(summary)
     write_json(out / "summary.json", summary)
     return summary
+
+
+def _pair(info: dict[str, Any], key: str, fmt: str = ".4g") -> str | None:
+    """``"upper X, lower Y"`` of ``info[key_upper]`` and ``info[key_lower]`` (None without)."""
+    up, lo = info.get(f"{key}_upper"), info.get(f"{key}_lower")
+    if up is None or lo is None:
+        return None
+    return f"upper {format(up, fmt)}, lower {format(lo, fmt)}"
+
+
+def wear_zero_reason(summary: dict[str, Any]) -> str | None:
+    """Why a run's worn volume is zero on both bodies (None when anything was worn), from
+    its summary: no cycle done; a threshold criterion whose field (or damage sum) never
+    reached its threshold, with the largest value reached at the last simulated cycle
+    (``criterion_last_cycle``) and, for SWT, the projected cycles to first wear; a rate
+    criterion without dissipated energy or slip."""
+    if summary.get("wear_volume_upper_m3", 0.0) > 0 or summary.get("wear_volume_lower_m3",
+                                                                    0.0) > 0:
+        return None
+    if not summary.get("cycles"):
+        return "no cycle was completed (the run stopped before its first cycle's end)"
+    crit = summary.get("criterion") or {}
+    name, info = crit.get("name", "the criterion"), summary.get("criterion_last_cycle") or {}
+    if name == "dfdi":
+        got = _pair(info, "max_dfdi")
+        return ("the DFDI damage sum never reached its threshold 1 at any material point"
+                + (f" (largest after the last simulated cycle: {got})" if got else ""))
+    if name == "swt":
+        got = _pair(info, "miner_sum_max")
+        first = _pair(info, "cycles_to_first_wear", ".4g")
+        return ("Miner's SWT damage sum never reached its threshold 1 at any material point"
+                + (f" (largest after the last simulated cycle: {got})" if got else "")
+                + (f"; projected cycles to first wear: {first}" if first else ""))
+    if crit.get("kind") == "threshold":
+        unit = crit.get("unit", "")
+        u = "" if unit in ("", "-") else f" {unit}"  # "-": dimensionless
+        thr = crit.get("threshold")
+        got = _pair(info, "max_value")
+        return (f"the {name} criterion's field never reached its threshold"
+                + (f" {thr:.4g}{u}" if thr is not None else "")
+                + (f" (largest over the last simulated cycle: {got}{u})" if got else ""))
+    if not summary.get("dissipated_energy_total_J"):
+        return (f"the {name} criterion wears where the contact slips, and no energy was "
+                "dissipated (the contact stuck: no slip)")
+    return f"the {name} criterion gave no wear depth at any grid point"
 
 
 def _profile_rows(hist: FrettingHistory, k: int = 5) -> list[int]:
@@ -167,6 +214,33 @@ def write_vtk_surfaces(hist: FrettingHistory, out: Path) -> list[Path]:
     return paths
 
 
+def debris_layer_figure(ph: Any) -> Any:
+    """``debris_layer.png``'s figure of DE phase ``ph`` (a :class:`DEPhaseResult`): the
+    particles coloured by the force on each (mN) and by the distance moved in the loading
+    step (nm), each with its colour bar; a constrained layout keeps the titles clear of the
+    colour bars."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    moved = np.linalg.norm(ph.positions - ph.start_positions, axis=1)
+    fmag = np.linalg.norm(ph.particle_force, axis=1)
+    fig, axes = plt.subplots(1, 2, figsize=(11, 5), layout="constrained")
+    for ax, val, lab in ((axes[0], fmag * 1e3, "force on particle (mN)"),
+                         (axes[1], moved * 1e9, "moved distance (nm)")):
+        sc = ax.scatter(ph.positions[:, 0] * 1e3, ph.positions[:, 1] * 1e3, c=val, s=2,
+                        cmap="viridis")
+        fig.colorbar(sc, ax=ax, label=lab, shrink=0.9)
+        ax.set_aspect("equal")
+        ax.set_xlabel("x (mm)")
+        ax.set_ylabel("y (mm)")
+    axes[0].set_title(f"debris layer, cycle {ph.cycle}: {ph.particles:,} particles\n"
+                      "force on each (figs 5.23/5.26)", fontsize=10)
+    axes[1].set_title("distance moved in the loading step\n(figs 5.20/5.21)", fontsize=10)
+    return fig
+
+
 def write_debris_outputs(hist: FrettingHistory, out: Path, figures: bool = True,
                          vtk: bool = True) -> list[Path]:
     """Debris of each DE phase: ``debris_CCCC.vtu`` (particles with force, moved distance,
@@ -202,20 +276,7 @@ def write_debris_outputs(hist: FrettingHistory, out: Path, figures: bool = True,
     import matplotlib.pyplot as plt
 
     ph = hist.de_phases[-1]
-    moved = np.linalg.norm(ph.positions - ph.start_positions, axis=1)
-    fmag = np.linalg.norm(ph.particle_force, axis=1)
-    fig, axes = plt.subplots(1, 2, figsize=(11, 4.5))
-    for ax, val, lab in ((axes[0], fmag * 1e3, "force on particle (mN)"),
-                         (axes[1], moved * 1e9, "moved distance (nm)")):
-        sc = ax.scatter(ph.positions[:, 0] * 1e3, ph.positions[:, 1] * 1e3, c=val, s=2,
-                        cmap="viridis")
-        fig.colorbar(sc, ax=ax, label=lab)
-        ax.set_aspect("equal")
-        ax.set_xlabel("x (mm)")
-        ax.set_ylabel("y (mm)")
-    axes[0].set_title(f"debris layer, cycle {ph.cycle}: {ph.particles} particles (figs 5.23/5.26)")
-    axes[1].set_title("distance moved in the loading step (figs 5.20/5.21)")
-    fig.tight_layout()
+    fig = debris_layer_figure(ph)
     paths.append(write_figure(out / "debris_layer.png", fig))
     g = hist.grid
     j = g.n // 2
@@ -228,11 +289,12 @@ def write_debris_outputs(hist: FrettingHistory, out: Path, figures: bool = True,
     axes[0].set_ylabel("contact pressure on lower body (MPa)")
     axes[0].set_title(f"central section, cycle {ph.cycle} (figs 5.22/5.24)")
     axes[0].legend(fontsize=8)
-    for p in hist.de_phases:
+    for k, p in enumerate(hist.de_phases):
         axes[1].plot(p.history[:, 0], p.history[:, 1], label=f"cycle {p.cycle}")
-        axes[1].axhline(p.target_N, color="k", lw=0.5, ls="--")
+        axes[1].axhline(p.target_N, color="k", lw=0.5, ls="--",
+                        label="target" if k == 0 else None)
     axes[1].set_xlabel("DE step")
-    axes[1].set_ylabel("servo force on the debris (N); dashed: target")
+    axes[1].set_ylabel("servo force on the debris (N)")
     axes[1].legend(fontsize=7)
     fig.tight_layout()
     paths.append(write_figure(out / "debris_pressure.png", fig))

@@ -131,7 +131,8 @@ def prepare_loop(cfg: FrettingConfig, out: Path, resume: bool,
 RUN_OUTPUTS = ("results.csv", "summary.json", "criterion.csv", "profiles.csv",
                "profiles.png", "wear_scar.png", "wear_vs_cycle.png", "debris_layer.png",
                "debris_pressure.png", "surface_*.vtu", "debris_*.vtu", "debris_*.pvd",
-               "de_surface_*.stl", "debris*.csv", CHECKPOINT)
+               "de_surface_*.stl", "debris*.csv", "fe/fields.pvd", "fe/cycle_*/job*.vtu",
+               CHECKPOINT)
 
 
 def remove_earlier_outputs(out: Path) -> None:
@@ -206,6 +207,13 @@ def write_outputs(case: FrettingCase, loop: FrettingLoop, hist: FrettingHistory,
         files += [p.name for p in write_figures(hist, out)]
     if cfg.output.vtk:
         files += [p.name for p in write_vtk_surfaces(hist, out)]
+        if loop.solver.runs_ccx and loop.solver.workdir is not None:
+            # each ccx job's mesh and fields for ParaView: fe/cycle_*/job.vtu, fe/fields.pvd
+            from tribodem.contact.fe.fields import write_fields
+
+            pvd = write_fields(loop.solver.workdir, loop.cycles_done)
+            if pvd is not None:
+                files.append(pvd.relative_to(out).as_posix())
     if hist.de_phases:
         files += [p.name for p in write_debris_outputs(hist, out, figures=cfg.output.figures,
                                                        vtk=cfg.output.vtk)]

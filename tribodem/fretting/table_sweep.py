@@ -55,6 +55,7 @@ from tribodem.fretting.config import (
     read_config,
     recorded_config,
     resolve_config,
+    resume_diffs,
 )
 from tribodem.fretting.output import CHECKPOINT, read_checkpoint
 from tribodem.fretting.runner import Echo, run
@@ -289,9 +290,12 @@ def member_plan(cfg_data: dict[str, Any], d: Path) -> tuple[str, Any]:
     cfg = validate(FrettingConfig, cfg_data, source=f"member '{d}'")
     new = effective_config(cfg.record())
     s = read_summary(d)
-    old = (s or {}).get("config")
-    old = effective_config(recorded_config(old)) if isinstance(old, dict) else None
-    if s is not None and old == new:
+    recorded = (s or {}).get("config")
+    old = effective_config(recorded_config(recorded)) if isinstance(recorded, dict) else None
+    # the same run: every field equal, a field added to tribodem since the record was made
+    # left at its default (resume_diffs, nothing free)
+    if s is not None and isinstance(recorded, dict) and not resume_diffs(
+            recorded, cfg.record(), may_change=()):
         if s.get("stopped"):
             return "stopped", s
         if s.get("cycles") == cfg.cycles:
@@ -312,7 +316,9 @@ def member_plan(cfg_data: dict[str, Any], d: Path) -> tuple[str, Any]:
     if old is None:
         return "new", None
     a, b = flatten(old), flatten(new)
-    diff = [k for k in sorted(set(a) | set(b)) if a.get(k) != b.get(k)]
+    default = flatten(FrettingConfig().record())  # a field newer than the record: default
+    diff = [k for k in sorted(set(a) | set(b)) if a.get(k) != b.get(k)
+            and not (k not in a and k in default and b.get(k) == default[k])]
     if not diff:
         return "new", "its run did not finish and left no usable checkpoint"
     k = diff[0]

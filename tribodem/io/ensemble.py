@@ -26,6 +26,10 @@ failed, reports a failed member without stopping the others, and on Ctrl-C (or a
 kills the local workers, sets the sweep's stop event (tasks on a remote cluster that poll it
 with :func:`stop_check` stop at their next checkpoint), cancels the futures, closes the
 client and the local cluster, and re-raises.
+
+Dask (``dask`` and ``distributed``) is the optional extra ``cluster`` (``pip install
+'tribodem[cluster]'``): without it a command that needs a cluster is refused before any work
+(:func:`require_dask`, exit 2, naming the install command).
 """
 
 from __future__ import annotations
@@ -47,6 +51,22 @@ WORKER_ENV = {"NUMBA_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS
               "OPENBLAS_NUM_THREADS": "1"}
 #: seconds between two looks at the sweep's stop event inside a running member
 STOP_POLL_S = 2.0
+#: how to install what the commands on a cluster need (Dask: the extra ``cluster``)
+CLUSTER_INSTALL = "pip install 'tribodem[cluster]'"
+
+
+def require_dask(command: str = "this command", alternative: str = "") -> None:
+    """``ConfigError`` (exit 2, before any work) when Dask (``dask`` and ``distributed``,
+    the extra ``cluster``) is not installed: it names ``command``, the install command and
+    ``alternative`` (e.g. running in this process)."""
+    try:
+        import dask  # noqa: F401
+        import distributed  # noqa: F401
+    except ImportError as err:
+        raise ConfigError(
+            f"{command} runs on a Dask cluster, but {err.name or 'dask'} is not installed; "
+            f"install it with: {CLUSTER_INSTALL}" + (f" (or {alternative})" if alternative
+                                                     else "")) from None
 
 
 @dataclass
@@ -126,9 +146,12 @@ def check_scheduler(scheduler: str) -> dict[str, str]:
                       "file")
 
 
-def check_cluster_options(command: str, workers: int, scheduler: str | None) -> None:
+def check_cluster_options(command: str, workers: int, scheduler: str | None,
+                          in_process: bool = False, alternative: str = "") -> None:
     """``--workers`` (a local cluster's size) and ``--scheduler`` (an existing cluster)
-    exclude each other; the scheduler must look like one (:func:`check_scheduler`).
+    exclude each other; the scheduler must look like one (:func:`check_scheduler`); Dask
+    must be installed (:func:`require_dask`, naming ``alternative``) unless the work runs
+    ``in_process``.
     ``ConfigError`` naming ``command``, the option and the value otherwise."""
     if scheduler is not None and workers:
         raise ConfigError(f"{command}: --workers = {workers}: sets the local cluster's size, "
@@ -136,13 +159,16 @@ def check_cluster_options(command: str, workers: int, scheduler: str | None) -> 
                           "workers); allowed: one of the two")
     if scheduler is not None:
         check_scheduler(scheduler)
+    if not in_process:
+        require_dask(command, alternative)
 
 
 def open_client(scheduler: str | None, workers: int) -> tuple[Any, Any]:
     """(client, local cluster or None): a ``LocalCluster`` of ``workers`` processes (0 =
     all local cores) with one thread each, or a client of the cluster at ``scheduler``
     (``tcp://HOST:PORT``, ``tls://...`` or a scheduler JSON file); ``ConfigError`` naming
-    ``--scheduler`` when it cannot be reached within 15 s."""
+    ``--scheduler`` when it cannot be reached within 15 s (or Dask is not installed)."""
+    require_dask()
     import dask
     from distributed import Client, LocalCluster
 
@@ -240,6 +266,7 @@ def run_members(todo: Sequence[Member], total: int, done_before: int, *,
     exception in its task, a task lost with its workers too often, a folder the client
     cannot see) is reported through ``echo`` and left out; the others go on. Ctrl-C or any
     error: stop event set, futures cancelled, client and local cluster closed, re-raised."""
+    require_dask()
     from distributed import Event
 
     from tribodem.io import runs

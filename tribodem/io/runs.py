@@ -16,6 +16,7 @@ progress bar (tqdm on stderr, with an ETA; off when ``enabled`` is false).
 from __future__ import annotations
 
 import functools
+import math
 import os
 import tempfile
 from collections.abc import Callable, Iterator
@@ -275,18 +276,35 @@ def available_memory() -> int:
     return int(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
 
 
-def check_memory(count: int, bytes_each: float, field: str, fraction: float = 0.8) -> None:
+def check_memory(count: float, bytes_each: float, field: str, fraction: float = 0.8, *,
+                 given: str | None = None, what: str = "", allowed: str | None = None
+                 ) -> None:
     """Refuse (``ConfigError``) ``count`` items of ``bytes_each`` when that is above
     ``fraction`` of the memory available, naming the field, the value and the largest count
-    that fits."""
+    that fits.
+
+    ``count`` may be a float (an estimate; infinite: more than any machine has). When the
+    count is not the field's value but follows from it (the cells of a grid, the particles
+    of a cell), ``given`` is the field's value as the message writes it, ``what`` names the
+    items ("the track grid's cells") and ``allowed`` says what would do."""
     have = available_memory()
-    need = count * bytes_each
-    if need > fraction * have:
-        fits = int(fraction * have / bytes_each)
-        raise ConfigError(
-            f"{field} = {count!r}: needs about {need / 2**30:.3g} GiB (~{bytes_each:.0f} B "
-            f"each), but this machine has {have / 2**30:.1f} GiB available; allowed: at most "
-            f"about {fits:,}")
+    try:
+        need = float(count) * bytes_each
+    except OverflowError:  # an integer beyond any float
+        need = math.inf
+    if need <= fraction * have:
+        return
+    fits = int(fraction * have / bytes_each)
+    size = (f"about {need / 2**30:.3g} GiB" if math.isfinite(need) else
+            "more memory than any machine has")
+    machine = (f"(~{bytes_each:.0f} B each), but this machine has {have / 2**30:.1f} GiB "
+               "available")
+    if given is None:
+        raise ConfigError(f"{field} = {count!r}: needs {size} {machine}; allowed: at most "
+                          f"about {fits:,}")
+    shown = f"{count:.3g}" if isinstance(count, float) else f"{count:,}"
+    raise ConfigError(f"{field} = {given}: {what or 'the items'} ({shown}) need {size} "
+                      f"{machine}; allowed: {allowed or f'at most about {fits:,} of them'}")
 
 
 def check_threads(threads: int, field: str, zero_means_all: bool = True) -> int:

@@ -1,10 +1,12 @@
-"""STL triangle meshes (ASCII and binary) and height maps as triangles.
+"""STL triangle meshes (ASCII and binary, read and written by meshio) and height maps as
+triangles.
 
 Seed 003 (section 3.2.6) exchanges the first-body geometry between the FE and DE phases as
 ``.stl`` files. Triangles are ``(n, 3, 3)`` float arrays (triangle, vertex, xyz; m); the
 vertex order gives the outward normal by the right-hand rule. Binary STL stores float32:
-reading returns those values exactly (as float64). ASCII is written with 17 significant
-digits, so any float64 coordinates round-trip bit for bit.
+reading returns those values exactly (as float64). ASCII is written with the shortest
+decimal that reads back the same float64 (meshio writes Python's ``repr``), so any float64
+coordinates round-trip bit for bit.
 """
 
 from __future__ import annotations
@@ -13,9 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from tribodem.io.results import atomic_write, write_text
-
-_BIN_DTYPE = np.dtype([("normal", "<f4", (3,)), ("v", "<f4", (3, 3)), ("attr", "<u2")])
+from tribodem.io.results import atomic_write
 
 
 def triangle_normals(triangles: np.ndarray) -> np.ndarray:
@@ -43,54 +43,47 @@ def _checked(triangles: np.ndarray) -> np.ndarray:
 
 def write_stl(path: str | Path, triangles: np.ndarray, binary: bool = True,
               name: str = "tribodem") -> Path:
-    """Write triangles (m) to an STL file, binary (default, float32) or ASCII (17 digits);
-    returns the path."""
+    """Write triangles (m) to an STL file, binary (default, float32) or ASCII (float64 that
+    read back bit for bit; the solid named ``name``), atomically; returns the path."""
+    import meshio
+
     t = _checked(triangles)
-    path = Path(path)
-    nrm = triangle_normals(t)
-    if binary:
-        rec = np.zeros(t.shape[0], dtype=_BIN_DTYPE)
-        rec["normal"] = nrm
-        rec["v"] = t
-        header = f"binary STL {name}".encode("ascii", "replace")[:80].ljust(80, b" ")
-        payload = header + np.uint32(t.shape[0]).tobytes() + rec.tobytes()
-        return atomic_write(path, lambda p: p.write_bytes(payload))
-    lines = [f"solid {name}"]
-    for k in range(t.shape[0]):
-        nx, ny, nz = nrm[k]
-        lines.append(f"  facet normal {nx:.9g} {ny:.9g} {nz:.9g}")
-        lines.append("    outer loop")
-        for v in t[k]:
-            lines.append(f"      vertex {v[0]:.17g} {v[1]:.17g} {v[2]:.17g}")
-        lines.append("    endloop")
-        lines.append("  endfacet")
-    lines.append(f"endsolid {name}")
-    return write_text(path, "\n".join(lines) + "\n")
+    n = t.shape[0]
+    mesh = meshio.Mesh(t.reshape(-1, 3), [("triangle", np.arange(3 * n).reshape(n, 3))],
+                       cell_data={"facet_normals": [triangle_normals(t)]})
+
+    def w(p: Path) -> None:
+        meshio.write(p, mesh, file_format="stl", binary=binary)
+        if not binary:  # meshio's ASCII solid has no name: give it ``name``
+            body = p.read_text()
+            body = body.removeprefix("solid\n").removesuffix("endsolid\n")
+            p.write_text(f"solid {name}\n{body}endsolid {name}\n")
+    return atomic_write(path, w)
 
 
 def read_stl(path: str | Path) -> np.ndarray:
-    """Triangles ``(n, 3, 3)`` (float64 of the stored values) of an ASCII or binary STL."""
+    """Triangles ``(n, 3, 3)`` (float64 of the stored values) of an ASCII or binary STL
+    (meshio; a binary file is told by its size, whatever its header says); ``ValueError``
+    for a file that is neither."""
+    import meshio
+
     path = Path(path)
-    data = path.read_bytes()
-    if len(data) >= 84:
-        n = int(np.frombuffer(data, dtype="<u4", count=1, offset=80)[0])
-        if len(data) == 84 + 50 * n:
-            rec = np.frombuffer(data, dtype=_BIN_DTYPE, count=n, offset=84)
-            return rec["v"].astype(np.float64)
-    head = data[:512].lstrip().lower()
-    if not head.startswith(b"solid"):
+    size = path.stat().st_size
+    with path.open("rb") as fh:
+        head = fh.read(512)
+    binary = size >= 84 and 84 + 50 * int.from_bytes(head[80:84], "little") == size
+    if not binary and not head.lstrip().lower().startswith(b"solid"):
         raise ValueError(f"stl '{path}': neither binary (size does not match the triangle "
                          "count) nor ASCII (no 'solid' header)")
-    tokens = data.split()
-    idx = [k for k, tok in enumerate(tokens) if tok.lower() == b"vertex"]
-    if len(idx) % 3:
-        raise ValueError(f"stl '{path}': {len(idx)} vertices is not a multiple of 3")
-    try:
-        v = np.array([[float(tokens[k + 1]), float(tokens[k + 2]), float(tokens[k + 3])]
-                      for k in idx], dtype=np.float64)
-    except (ValueError, IndexError) as exc:
-        raise ValueError(f"stl '{path}': malformed vertex line ({exc})") from exc
-    return v.reshape(-1, 3, 3)
+    try:  # meshio sizes an ASCII file as if binary first: uint32 arithmetic may overflow
+        with np.errstate(over="ignore"):
+            mesh = meshio.read(path, file_format="stl")
+    except (meshio.ReadError, ValueError, IndexError) as exc:
+        raise ValueError(f"stl '{path}': malformed ({type(exc).__name__}: {exc})") from exc
+    cells = mesh.cells_dict.get("triangle")
+    if cells is None:
+        return np.zeros((0, 3, 3))
+    return np.asarray(mesh.points, dtype=np.float64)[np.asarray(cells)]
 
 
 def heightmap_to_triangles(x: np.ndarray, y: np.ndarray, z: np.ndarray) -> np.ndarray:

@@ -232,7 +232,9 @@ def calibrate(material: str, out: str | os.PathLike[str], *, quick: bool = False
         raise ConfigError(f"calibrate: --workers = {workers!r}: allowed: 0..1024 (0 = a "
                           "worker per core, 1 = in this process)")
     spec = LIBRARY[key]
-    check_cluster_options("calibrate", workers, scheduler)
+    check_cluster_options("calibrate", workers, scheduler,
+                          in_process=scheduler is None and workers == 1,
+                          alternative="--workers 1 to run in this process")
     path = as_out(out)
     runs.check_out_dir(path, "--out")
     runs.announce(path)

@@ -9,9 +9,11 @@ from pathlib import Path
 
 import typer
 
+from tribodem.io.helptext import reflowed
 from tribodem.materials.calibration import FULL_SPECIMENS, QUICK_SPECIMENS
 
 
+@reflowed
 def calibrate(
     material: str = typer.Option(..., "--material", help="q345b (disc) or cu-pm (pad)."),
     out: Path = typer.Option(..., "--out", help="Output directory."),
@@ -33,11 +35,15 @@ def calibrate(
     progress: bool = typer.Option(True, "--progress/--no-progress",
                                   help="Progress bar (compression tests) with ETA on stderr."),
 ) -> None:
-    """Calibrate E_c and kratio by uniaxial compression (seed 000 eq 12) to table 1's E, nu:
-    writes summary.json, history.csv and stress_strain.png.
+    """Calibrate the bond micro-parameters E_c and kratio so that uniaxial compression of
+    packed specimens gives the material's E and nu (Sha et al. 2022, table 1): writes
+    summary.json, history.csv and stress_strain.png.
 
-    The specimens are packed and each iteration's compression tests run one task per
-    specimen on Dask (the same results on any number of workers)."""
+    E and nu of a test are Sha et al.'s eq 12: the slopes of the axial stress and of the
+    lateral strain against the axial strain, fitted between 10 % and 50 % of the peak
+    stress. Each iteration's compression tests run one task per specimen on Dask (the same
+    results on any number of workers; --workers 1 runs them in this process, without
+    Dask)."""
     from tribodem.materials.calibration import calibrate as run_calibration
 
     run_calibration(material, out, quick=quick, seed=seed, specimens=specimens,

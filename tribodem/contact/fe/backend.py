@@ -406,12 +406,17 @@ class FEContactSolver(CcxBackend[Mesh]):
                       comp: int = 1) -> NDArray[np.float64]:
         """Displacement component ``comp`` (1: x, 2: y) of nodes ``ids`` at total time ``t``."""
         assert self.results is not None
-        key = (set_name, t)
         if self._disp is None or self._disp_of is not self.results:
             self._disp = {(b.set_name, b.time): b.rows for b in self.results.dat
                           if b.kind == "displacements"}
             self._disp_of = self.results
-        rows = self._disp[key]
+        # the .dat file prints the times rounded (2.16667 for 2 + 1/6): the nearest one
+        times = [bt for name, bt in self._disp if name == set_name]
+        near = min(times, key=lambda bt: abs(bt - t), default=None)
+        if near is None or abs(near - t) > 1e-5 * max(1.0, abs(t)):
+            raise FESolverStopped(f"ccx output has no {set_name} displacements at total time "
+                                  f"{t:g} (deck {self.jobs[-1].deck if self.jobs else '?'})")
+        rows = self._disp[(set_name, near)]
         order = np.argsort(rows[:, 0])
         j = order[np.searchsorted(rows[order, 0], ids)]
         return rows[j, comp]

@@ -48,6 +48,29 @@ class DatBlock:
 
 def read_dat(path: str | Path) -> list[DatBlock]:
     """All blocks of a ccx ``.dat`` file in file order."""
+    return _dat_blocks(Path(path).read_text().splitlines())
+
+
+_HEADER_TIME = re.compile(r"^[ \t]*[a-z][^\n]*\)\s*for\s+(?:set\s+\S+|all contact elements)\s+"
+                          r"and time\s+(\S+)", re.MULTILINE)
+
+
+def read_dat_last(path: str | Path) -> tuple[float | None, list[DatBlock]]:
+    """(the last output time, its blocks) of a ccx ``.dat`` file: the headers are found in
+    the text and only the blocks from the first one of that time on are parsed (a job's
+    ``.dat`` holds tens of output times). (None, []) for a file without blocks."""
+    text = Path(path).read_text()
+    heads = [(m.start(), float(m.group(1))) for m in _HEADER_TIME.finditer(text)]
+    if not heads:
+        return None, []
+    last = max(t for _, t in heads)
+    start = next(pos for pos, t in heads if t == last)
+    blocks = [b for b in _dat_blocks(text[start:].splitlines()) if b.time == last]
+    return last, blocks
+
+
+def _dat_blocks(lines: list[str]) -> list[DatBlock]:
+    """The blocks of the lines of a ``.dat`` file (see :func:`read_dat`)."""
     blocks: list[DatBlock] = []
     cur: DatBlock | None = None
     buf: list[list[float]] = []
@@ -58,7 +81,7 @@ def read_dat(path: str | Path) -> list[DatBlock]:
                 np.zeros((0, 0))
             blocks.append(cur)
 
-    for line in Path(path).read_text().splitlines():
+    for line in lines:
         m = _HEADER.match(line)
         if m:
             close()
