@@ -1,6 +1,6 @@
 """Clump throughput: 80,000 debris clumps (thirds of spherical / chunk / rubbing, d = 0.6 um,
 steel, Hertz-Mindlin CoR 0.72, mu 0.6, mu_r 0.001) settling on a plane under gravity with a
-light boundary-moving top load (seed 003 eqs 3.2-3.6), periodic in x and y.
+light boundary-moving top load (Lu (2018) eqs 3.2-3.6), periodic in x and y.
 
     .venv/bin/python benchmarks/bench_clumps.py [--clumps 80000] [--steps 300] [--threads 1 2]
 

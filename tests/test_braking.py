@@ -1,4 +1,4 @@
-"""Braking interface model (seed 000 sections 3.2-5, table 4)."""
+"""Braking interface model (Sha et al. (2022) sections 3.2-5, table 4)."""
 
 from __future__ import annotations
 

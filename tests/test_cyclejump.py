@@ -1,4 +1,4 @@
-"""Cycle-jumping strategies (seed 003 chapter 4)."""
+"""Cycle-jumping strategies (Lu (2018) chapter 4)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Linear parallel bond: elastic response and breakage at the closed-form loads (seed 000
+"""Linear parallel bond: elastic response and breakage at the closed-form loads (Sha et al. (2022)
 eq 11, Potyondy & Cundall 2004), 2D disks and 3D spheres driven by prescribed motion."""
 
 from __future__ import annotations
@@ -23,7 +23,7 @@ from tribodem.dem.state import FIX_ROTATION, FIX_TRANSLATION
 R = 1.0e-3  # particle radius (m)
 GAP = 1.0e-5  # surface gap between the bonded particles (m): no contact force
 E_BOND = 1.0e9  # Pa
-KRATIO = 1.75  # seed 000 table 3
+KRATIO = 1.75  # Sha et al. (2022) table 3
 SIGMA_T = 1.0e6  # tensile strength (Pa)
 COH = 1.5e6  # cohesion (Pa)
 LAM = 0.8  # bond radius multiplier

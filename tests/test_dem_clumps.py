@@ -1,5 +1,5 @@
 """Rigid clumps: union volumes, torque-free rotation, rigidity, free fall, resting weight,
-checkpoints and periodic wrap (seed 003 figure 3.6 debris shapes)."""
+checkpoints and periodic wrap (Lu (2018) figure 3.6 debris shapes)."""
 
 from __future__ import annotations
 

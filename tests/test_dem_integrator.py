@@ -1,4 +1,5 @@
-"""Central-difference integrator: free flight, viscous damping (seed 000 eq 4), local damping."""
+"""Central-difference integrator: free flight, viscous damping (Sha et al. (2022) eq 4), local
+damping."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Servo walls hold a target force on a bed of >= 1000 particles (seed 003 eqs 3.2-3.6)."""
+"""Servo walls hold a target force on a bed of >= 1000 particles (Lu (2018) eqs 3.2-3.6)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Thermal room (seed 000 eq 13): free expansion of a bonded block, conduction through
+"""Thermal room (Sha et al. (2022) eq 13): free expansion of a bonded block, conduction through
 intact bonds only, boundary curves."""
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """The ``fe3d`` first-body backend (CalculiX, 3D crossed cylinders, half model) behind the contract.
 
-Closed forms and tolerances (seed 003: EN24T crossed cylinders R = 4 mm, 100 N, mu 0.6):
+Closed forms and tolerances (Lu (2018): EN24T crossed cylinders R = 4 mm, 100 N, mu 0.6):
 
 * Hertz point contact (Johnson 4.22-4.23, a sphere of R on a flat): on the window, the peak
   pressure p0 = 3 P / (2 pi a^2) within 3 %, the contact radius a = (3 P R / (4 E*))^(1/3)

@@ -1,4 +1,4 @@
-"""Debris third body (seed 003 3.2.6-3.2.7): eq 3.10 mass conservation, eqs 3.11-3.15,
+"""Debris third body (Lu (2018) 3.2.6-3.2.7): eq 3.10 mass conservation, eqs 3.11-3.15,
 servo to the target load, forces mapped back and load sharing in the first-body solver."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Seed 003 section 5.4 debris study (`tribodem fretting debris-study`).
+"""Lu (2018) section 5.4 debris study (`tribodem fretting debris-study`).
 
 Closed forms: the centre / edge zones and their mean pressures on a Hertz distribution;
 equilibrium (solid + debris force on the lower body = the applied load) and the imposed

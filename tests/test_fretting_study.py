@@ -1,4 +1,4 @@
-"""``tribodem fretting study`` (seed 003 chapter 6) through the installed command, on a
+"""``tribodem fretting study`` (Lu (2018) chapter 6) through the installed command, on a
 small grid with the elastic half-space."""
 
 from __future__ import annotations

@@ -1,4 +1,5 @@
-"""Materials room (seed 000 section 3.1): specimen generation, uniaxial compression (eq 12),
+"""Materials room (Sha et al. (2022) section 3.1): specimen generation, uniaxial compression
+(eq 12),
 automatic calibration of E_c and kratio to table 1, and ``tribodem calibrate``."""
 
 from __future__ import annotations
@@ -47,7 +48,7 @@ def test_library_tables_1_and_3() -> None:
 def test_specimen_has_no_floating_particles_and_is_bonded(specimen: Specimen) -> None:
     sp = specimen
     assert 60 <= sp.n <= 110 and sp.n_deleted > 0  # ~0.05 x 0.1 mm of 3.6 um disks
-    assert np.all(sp.compaction_contacts >= 3)  # seed 000 3.1 (2): no floaters kept
+    assert np.all(sp.compaction_contacts >= 3)  # Sha et al. (2022) 3.1 (2): no floaters kept
     per = sp.bonds_per_particle()
     assert per.min() >= 1 and per.mean() > 2.5 and sp.n_bonds > sp.n
     # bonds join neighbours within the bond gap of the compacted packing

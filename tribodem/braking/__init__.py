@@ -1,4 +1,4 @@
-"""Braking interface wear model (seed 000 sections 3.2-5): pad over disc, rough surfaces,
+"""Braking interface wear model (Sha et al. (2022) sections 3.2-5): pad over disc, rough surfaces,
 periodic in x, pressure plate on the pad, sliding disc; table 4 conditions; wear depth,
 broken bonds, debris, force chains, transfer layer.
 

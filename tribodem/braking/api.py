@@ -132,7 +132,7 @@ def run(config: ConfigSource = None, out: str | os.PathLike[str] | None = None, 
     tell = _Teller(echo)
     if condition is not None and condition not in CONDITIONS:
         raise ConfigError(f"braking run: --condition = {condition!r}: must be one of "
-                          f"{sorted(CONDITIONS)} (seed 000 table 4)")
+                          f"{sorted(CONDITIONS)} (Sha et al. (2022) table 4)")
     if condition is None and config is None and not resume:
         raise ConfigError("braking run: give --condition 1..5 or --config FILE")
     if out is None:
@@ -168,7 +168,7 @@ def _check_conditions(conditions: Sequence[int] | None) -> list[int]:
     if not conds or len(set(conds)) < len(conds) or not all(
             isinstance(k, int) and k in CONDITIONS for k in conds):
         raise ConfigError(f"braking sweep: --conditions = {conditions!r}: allowed: distinct "
-                          f"conditions of {sorted(CONDITIONS)} (seed 000 table 4), e.g. "
+                          f"conditions of {sorted(CONDITIONS)} (Sha et al. (2022) table 4), e.g. "
                           "[1, 3, 5]")
     return sorted(conds)
 

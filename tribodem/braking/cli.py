@@ -1,4 +1,4 @@
-"""``tribodem braking run`` and ``tribodem braking sweep`` (seed 000, Sha et al. 2022:
+"""``tribodem braking run`` and ``tribodem braking sweep`` (Sha et al. (2022), Sha et al. 2022:
 sections 3.2-5, table 4): the options parsed, then :func:`tribodem.braking.run` /
 :func:`tribodem.braking.sweep` called and their result printed.
 
@@ -64,7 +64,7 @@ def parse_conditions(text: str | None) -> list[int] | None:
         return None
     return sorted(parse_int_list(
         text, "braking sweep: --conditions", lambda k: k in CONDITIONS,
-        f"distinct comma-separated conditions of {sorted(CONDITIONS)} (seed 000 table 4), "
+        f"distinct comma-separated conditions of {sorted(CONDITIONS)} (Sha et al. (2022) table 4), "
         "e.g. 1,3,5"))
 
 

@@ -1,4 +1,4 @@
-"""Sweep comparison: our condition 1-5 results beside seed 000 sections 3.4 and 5."""
+"""Sweep comparison: our condition 1-5 results beside Sha et al. (2022) sections 3.4 and 5."""
 
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ import numpy as np
 from tribodem.braking.conditions import CONDITIONS, SEED_BRAKING_TIME_S
 from tribodem.io.results import write_csv, write_json, write_text
 
-#: seed 000 section 5: (from, to, wear depth change %, force chain change %)
+#: Sha et al. (2022) section 5: (from, to, wear depth change %, force chain change %)
 SEED_CHANGES = [
     ("load 13->17 kN", 1, 2, 13.14, -23.37),
     ("load 17->21 kN", 2, 5, 11.61, -5.96),
@@ -21,7 +21,7 @@ SEED_CHANGES = [
     ("speed 1000->1200 r/min", 4, 5, 8.77, -3.86),
     ("speed 800->1200 r/min", 3, 5, 16.22, None),
 ]
-#: seed 000 figure 12 caption: condition 5 average wear depth (braking time s, depth m)
+#: Sha et al. (2022) figure 12 caption: condition 5 average wear depth (braking time s, depth m)
 SEED_FIG12 = [(0.1, 3.66e-7), (0.5, 5.42e-6), (1.0, 1.16e-5), (2.0, 2.15e-5), (4.0, 4.15e-5),
               (8.0, 7.69e-5)]
 
@@ -493,7 +493,7 @@ def _md_conditions(st: SweepStats, wall_s: float, cluster: str | int, quick: boo
         for k in sorted(st.per_seed["wear"]))
     missing = st.missing
     return [
-        "# Braking sweep: tribodem vs seed 000" + (" (--quick)" if quick else ""),
+        "# Braking sweep: tribodem vs Sha et al. (2022)" + (" (--quick)" if quick else ""),
         "",
         f"Condition(s) {', '.join(map(str, sorted(st.runs)))} of table 4"
         + (f" (not run or all failed: {', '.join(map(str, missing))})" if missing else "")

@@ -1,4 +1,4 @@
-"""Braking conditions of seed 000 table 4 and the load/speed conversions behind them.
+"""Braking conditions of Sha et al. (2022) table 4 and the load/speed conversions behind them.
 
 Table 4 gives each condition twice: initial braking load (kN) next to a simulation pressure
 (MPa), and initial braking speed (r/min) next to a relative sliding speed (m/s). The pairs
@@ -72,7 +72,7 @@ class Condition:
         return rpm_to_speed(self.rpm)
 
 
-#: seed 000 table 4
+#: Sha et al. (2022) table 4
 CONDITIONS: dict[int, Condition] = {
     1: Condition(1, 13.0, 1200.0, 0.33, 47.12),
     2: Condition(2, 17.0, 1200.0, 0.43, 47.12),
@@ -86,5 +86,5 @@ def get_condition(index: int) -> Condition:
     """Table 4 condition ``index`` (1..5); a clear ValueError otherwise."""
     if index not in CONDITIONS:
         raise ValueError(f"condition = {index!r}: must be one of {sorted(CONDITIONS)} "
-                         "(seed 000 table 4)")
+                         "(Sha et al. (2022) table 4)")
     return CONDITIONS[index]

@@ -119,7 +119,7 @@ class RunCfg(StrictModel):
         0.0, ge=0, le=0.1,
         description="debris outlet: a debris component leaves the cell once carried this "
                     "far (m) along the sliding relative to the pad (residence length, e.g. "
-                    "a pad plateau, 50-500 um); 0 = closed cell, as in seed 000")
+                    "a pad plateau, 50-500 um); 0 = closed cell, as in Sha et al. (2022)")
     worn_through_diameters: float = Field(
         2.0, ge=0, le=1000,
         description="stop the run (exit 3, outputs kept) when a body's remaining intact "

@@ -1,4 +1,4 @@
-"""Measurements of the braking interface (seed 000 sections 3.4 and 5), all frame-free.
+"""Measurements of the braking interface (Sha et al. (2022) sections 3.4 and 5), all frame-free.
 
 Definitions (reference state = the loaded interface at the start of sliding):
 

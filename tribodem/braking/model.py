@@ -1,4 +1,4 @@
-"""The braking interface of seed 000 section 3.2 / figure 8, built on ``tribodem.dem``.
+"""The braking interface of Sha et al. (2022) section 3.2 / figure 8, built on ``tribodem.dem``.
 
 Geometry: one bonded-particle block compacted in a box periodic in x (walls at its bottom
 and top, isotropic stress ``compaction_stress`` as in section 3.1), cut along two random
@@ -19,7 +19,7 @@ Boundary conditions (figure 8):
 - pad: the particles within one mean diameter of its top are held in x (the support wall)
   and pressed in -y by a pressure wall with the target force ``p W t``
   (pressure x cell width x disk thickness, 2D unit thickness): a ``PlaneWall`` in the
-  engine's ``"boundary"`` servo mode (``M a = F_target - F_wall``, seed 003 eq 3.6) with a
+  engine's ``"boundary"`` servo mode (``M a = F_target - F_wall``, Lu (2018) eq 3.6) with a
   small mass ``wall_mass_ratio`` x the pad slab mass and no damping, so its time-mean
   force is the target (PFC's gain servo cannot follow the pad after 47 m/s asperity
   impacts; see docs/braking.md);

@@ -1,6 +1,6 @@
 """Debris outlet: detached particles leave the interface after a residence length.
 
-The periodic cell of seed 000 is closed: every detached particle stays in it, the third
+The periodic cell of Sha et al. (2022) is closed: every detached particle stays in it, the third
 body grows until it separates the first bodies, and the wear rate falls towards zero
 (docs/braking.md "Long slides"). In a brake, debris leaves the contact: it is carried
 across a contact plateau and out at its trailing edge, into the gaps between plateaus or
@@ -17,7 +17,7 @@ pad (the pad is held in x, so the lab frame is the pad's frame). Debris lodged i
 does not move and stays; debris carried by the disc leaves after ``length / v``. The
 residence length is the contact length a particle crosses before it is out: the plateau
 size of the pad face, 50-500 um in brake pads (Eriksson and Jacobson 2000), not a
-quantity seed 000 gives, so it is an explicit option (``[run] outlet_length_m``; 0 = the
+quantity Sha et al. (2022) gives, so it is an explicit option (``[run] outlet_length_m``; 0 = the
 closed cell of the seed).
 
 A particle that leaves is *ejected*: its group becomes ``EJECTED``, its velocity and spin

@@ -1,4 +1,4 @@
-"""Figures of a braking run, like seed 000 figures 11-13 and 16-18 (matplotlib, Agg)."""
+"""Figures of a braking run, like Sha et al. (2022) figures 11-13 and 16-18 (matplotlib, Agg)."""
 
 from __future__ import annotations
 

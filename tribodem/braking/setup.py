@@ -57,7 +57,7 @@ class RunSetup:
     #: rises linearly to ``speed_m_s`` over ``speed_ramp_s`` seconds (0: at speed at once)
     speed_ramp_s: float = 0.0
     #: debris outlet (``outlet``): a debris component leaves the cell once carried this
-    #: far (m) along the sliding relative to the pad; 0 = closed cell (seed 000)
+    #: far (m) along the sliding relative to the pad; 0 = closed cell (Sha et al. (2022))
     outlet_length_m: float = 0.0
     #: stop when a body's remaining thickness falls below this many of its mean particle
     #: diameters (``WORN_THROUGH``); 0 = never stop

@@ -276,7 +276,7 @@ def _model_assumptions(setup: RunSetup) -> list[str]:
         "is not reached; wear_depth_mean_extrapolated_8s_m extrapolates the steady wear "
         "rate (slope over the second half of the run) linearly in time = in sliding "
         "distance at constant speed; it is an extrapolation, not a simulation",
-        "pressure wall: a pressure plate (engine 'boundary' servo, seed 003 eq 3.6), no "
+        "pressure wall: a pressure plate (engine 'boundary' servo, Lu (2018) eq 3.6), no "
         "damping, of mass " + (
             f"{setup.plate_areal_mass} kg/m^2 x W x t (the omitted pad and back plate: 15 mm "
             "Cu-PM + 6 mm steel assumed, the seed gives no sizes)"

@@ -1,4 +1,4 @@
-"""First-body contact solvers (DESIGN.md "The fretting FE-DE model"; seed 003 ch. 3, 5, 6).
+"""First-body contact solvers (DESIGN.md "The fretting FE-DE model"; Lu (2018) ch. 3, 5, 6).
 
 One contract, :class:`FirstBodySolver` with its :class:`Capabilities`, driven through
 fretting cycles by :class:`tribodem.fretting.FrettingLoop`. Backends, registered by name in

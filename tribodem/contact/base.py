@@ -1,4 +1,4 @@
-"""The first-body contract (seed 003, sections 3.3, 6.1): what every backend gives.
+"""The first-body contract (Lu (2018), sections 3.3, 6.1): what every backend gives.
 
 Conventions (SI throughout):
 

@@ -1,6 +1,6 @@
 """Elastic-plastic half-space backend on tamaas EPIC (DESIGN.md "The fretting FE-DE model").
 
-Model (seed 003 section 5.2: bilinear EN24T; replaces the Abaqus elastic-plastic FE phase):
+Model (Lu (2018) section 5.2: bilinear EN24T; replaces the Abaqus elastic-plastic FE phase):
 
 * Two bodies of the *same* elastic-plastic material under the same normal pressure have the
   same elastic-plastic response (a half-space's state depends only on its surface traction

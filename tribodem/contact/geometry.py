@@ -1,4 +1,4 @@
-"""First-body surface geometries as recession maps (seed 003 section 3.3.1, figure 3.4).
+"""First-body surface geometries as recession maps (Lu (2018) section 3.3.1, figure 3.4).
 
 A surface is described by its *recession* ``g(x, y)`` (m): the distance from the body's
 surface to the common tangent plane at the initial contact point, positive away from the
@@ -29,7 +29,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from tribodem.contact.base import Recession  # noqa: E402 - one definition, in the contract
 
-#: Seed 003 specimens: 8 mm diameter cylinders (radius 4 mm), the default of every curved body.
+#: Lu (2018) specimens: 8 mm diameter cylinders (radius 4 mm), the default of every curved body.
 SEED_RADIUS = 4e-3
 
 Contact = Literal["point", "line"]
@@ -308,7 +308,7 @@ def elliptical_semi_axes(radius_x: float, radius_y: float, load: float,
 
 @dataclass(frozen=True)
 class CrossedCylinders:
-    """Seed 003 case: upper cylinder's axis along y (radius ``radius_upper``, m), lower
+    """Lu (2018) case: upper cylinder's axis along y (radius ``radius_upper``, m), lower
     cylinder's axis along x (``radius_lower``, m); stroke along x. Point contact."""
 
     radius_upper: float = SEED_RADIUS

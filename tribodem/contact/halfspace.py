@@ -1,6 +1,6 @@
 """Half-space BEM backend on tamaas (DESIGN.md "The fretting FE-DE model", backend 1).
 
-Model (seed 003 sections 3.3 and 6.1, replacing the Abaqus FE phase):
+Model (Lu (2018) sections 3.3 and 6.1, replacing the Abaqus FE phase):
 
 * Normal problem: frictionless elastic contact of the two surfaces, reduced to a rigid
   surface (the summed recessions) on an elastic half-space of contact modulus
@@ -296,7 +296,7 @@ class HalfSpaceSolver(FirstBodySolver):
     def set_debris_pressure(self, pressure: NDArray[np.float64] | None) -> None:
         """Prescribe the debris (third-body) pressure on the window, Pa [n, n] (None clears).
 
-        Seed 003 section 3.2.7 (forces mapped back): the debris load acts on both bodies;
+        Lu (2018) section 3.2.7 (forces mapped back): the debris load acts on both bodies;
         their elastic displacement under it, u_d = (1 / (pi E*)) int p_d / r dA (exact cell
         integrals, not periodic), opens the gap, and the solid-solid contact carries the rest
         of the load, ``load - debris_load``. Kept until cleared (``reset`` keeps it too).

@@ -1,4 +1,4 @@
-"""tribodem.cyclejump: cycle-jumping (seed 003 chapter 4 and appendix III; eq 2.20).
+"""tribodem.cyclejump: cycle-jumping (Lu (2018) chapter 4 and appendix III; eq 2.20).
 
 ``strategies`` (the strategies of the thesis behind :class:`JumpStrategy`, error-controlled
 steps, :func:`replay` and the synthetic series), ``smooth`` (:class:`SmoothJump`, the default

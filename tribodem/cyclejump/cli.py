@@ -19,7 +19,7 @@ from tribodem.cyclejump.registry import STRATEGIES
 from tribodem.io.config import ConfigError
 
 jump_app = typer.Typer(
-    help="Cycle-jumping strategies (seed 003 chapter 4): replay a recorded series.",
+    help="Cycle-jumping strategies (Lu (2018) chapter 4): replay a recorded series.",
     no_args_is_help=True,
     add_completion=False,
     pretty_exceptions_enable=False,
@@ -76,7 +76,7 @@ def parse_params(strategy: str, items: list[str]) -> dict[str, Any]:
 
 @jump_app.callback()
 def _jump() -> None:
-    """Cycle-jumping strategies (seed 003 chapter 4)."""
+    """Cycle-jumping strategies (Lu (2018) chapter 4)."""
 
 
 @jump_app.command("replay")

@@ -1,7 +1,7 @@
 """A recorded per-cycle series replayed with a cycle-jumping strategy (``tribodem jump
 replay``).
 
-The input CSV has columns ``cycle,increment`` (wear per cycle, as appendix III of seed 003
+The input CSV has columns ``cycle,increment`` (wear per cycle, as appendix III of Lu (2018)
 reads ``Result.csv``); other columns are ignored. :func:`read_increments_csv` reads and
 checks it, :func:`replay_csv` replays it (:func:`~tribodem.cyclejump.strategies.replay`)
 and returns the summary the command prints, :func:`plot_replay` draws the replayed against

@@ -1,4 +1,4 @@
-"""Cycle-jumping strategies (seed 003, chapter 4 and appendix III; eq 2.20).
+"""Cycle-jumping strategies (Lu (2018), chapter 4 and appendix III; eq 2.20).
 
 A cycle-jumping strategy watches a per-cycle simulated quantity and, when the history
 looks safe, skips ``n`` cycles by extrapolating the state over them. One interface,

@@ -74,7 +74,7 @@ def compress2d_case(n: int = 50_000, steps: int = 2_000, seed: int = 0) -> Bench
     """Case (b): n linear-contact disks (unit thickness) compressed by two platens.
 
     Square lattice of spacing 7.15 um with radii uniform in [3.58, 3.6] um (the braking
-    particle size of seed 000), so every lattice neighbour starts in contact (overlap
+    particle size of Sha et al. (2022)), so every lattice neighbour starts in contact (overlap
     0.01-0.05 um); E 200 GPa (PFC deformability kn = 2 r t E*/(r1+r2)),
     rho 7850; the top and bottom platens approach at 0.1 m/s each (the seed's calibration
     speed); dt = 0.2 x sqrt(m_min / kn_max).

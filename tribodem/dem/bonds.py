@@ -1,4 +1,4 @@
-"""Linear parallel bond (Potyondy & Cundall 2004; PFC "linearpbond"; seed 000 eqs 9-11).
+"""Linear parallel bond (Potyondy & Cundall 2004; PFC "linearpbond"; Sha et al. (2022) eqs 9-11).
 
 A bond is a finite elastic cylinder (2D: a slab of thickness t) of radius
 ``Rb = lambda min(r_i, r_j)`` glued between two particles at the contact point
@@ -7,7 +7,7 @@ Section: area ``A`` (2D ``2 Rb t``, 3D ``pi Rb^2``), moment of inertia ``I`` (2D
 ``2/3 t Rb^3``, 3D ``pi Rb^4/4``), polar moment ``J`` (3D ``pi Rb^4/2``). Stiffness per
 area ``kn = E_bond / (r_i + r_j)`` (Pa/m), ``ks = kn / kratio``.
 
-Incremental update each step (seed 000 eqs 9-10; forces and moments start at zero when
+Incremental update each step (Sha et al. (2022) eqs 9-10; forces and moments start at zero when
 the bond is installed): with ``v_c`` the velocity of j minus i at the contact point and
 ``dtheta = (omega_j - omega_i) dt``,
 
@@ -21,7 +21,7 @@ normal (rigid rotation from the old to the new normal, then about the normal by 
 spin), as PFC does. Force on j: ``Fn n + Fs``; i gets the opposite; moments on j:
 ``Mb + Mt n`` plus ``(x_c - x_j) x F_j``.
 
-Maximum stresses (seed 000 eq 11 as in Potyondy & Cundall 2004, tension positive):
+Maximum stresses (Sha et al. (2022) eq 11 as in Potyondy & Cundall 2004, tension positive):
 ``sigma = -Fn/A + |Mb| Rb/I``, ``tau = |Fs|/A + |Mt| Rb/J`` (2D: no twist). The bond breaks
 in tension when ``sigma >= sigma_t`` (checked first), in shear when
 ``tau >= c - sigma_n tan(phi)`` with ``sigma_n = -Fn/A``. A broken bond carries nothing
@@ -186,7 +186,7 @@ def bond_forces(pos, vel, omega, radius, bi, bj, rb, area, ib, jb, kn, ks, tens,
         mb[b, 2] -= kni * (t2 - tn * n2)
         if dim == 3:
             mt[b] -= ks[b] * jb[b] * tn
-        # maximum stresses (seed 000 eq 11, Potyondy & Cundall 2004), tension positive
+        # maximum stresses (Sha et al. (2022) eq 11, Potyondy & Cundall 2004), tension positive
         fsm = np.sqrt(fs[b, 0] ** 2 + fs[b, 1] ** 2 + fs[b, 2] ** 2)
         mbm = np.sqrt(mb[b, 0] ** 2 + mb[b, 1] ** 2 + mb[b, 2] ** 2)
         sig_n = -fn[b] / area[b]
@@ -673,7 +673,7 @@ def bond_forces_2d(pos, vel, omega, radius, bi, bj, rb, area, ib, kn, ks, tens, 
         s0 -= ksa * (v0 - vn * n0) * dt
         s1 -= ksa * (v1 - vn * n1) * dt
         mz -= kn[b] * ib[b] * ((wj2 - wi2) * dt)
-        # maximum stresses (seed 000 eq 11, Potyondy & Cundall 2004), tension positive
+        # maximum stresses (Sha et al. (2022) eq 11, Potyondy & Cundall 2004), tension positive
         fsm = np.sqrt(s0 ** 2 + s1 ** 2)
         how = INTACT
         exact = True
@@ -1074,7 +1074,7 @@ class ParallelBonds:
         return float(min(dt_t, dt_r))
 
     def thermal_load(self, dT: np.ndarray, alpha: np.ndarray) -> None:
-        """Constrained thermal expansion of intact bonds (seed 000 eq 13): the normal force
+        """Constrained thermal expansion of intact bonds (Sha et al. (2022) eq 13): the normal force
         grows by ``kn A alpha L dT`` (+ = compression here; ``-kn A alpha L dT`` in PFC's
         tension-positive sign), with dT and alpha the means over the two particles."""
         if self.n_bonds == 0:

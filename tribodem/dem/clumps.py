@@ -1,4 +1,4 @@
-"""Rigid multi-sphere bodies (clumps) for debris shapes (seed 003 section 3.2.6, figure 3.6).
+"""Rigid multi-sphere bodies (clumps) for debris shapes (Lu (2018) section 3.2.6, figure 3.6).
 
 A clump is a rigid body made of overlapping member spheres ("grouping several spheres").
 Members are ordinary particles of the :class:`~tribodem.dem.state.ParticleState`, so pair
@@ -239,7 +239,7 @@ def _unit_template(shape: str) -> ClumpTemplate:
 
 
 def debris_template(shape: str, diameter: float) -> ClumpTemplate:
-    """Debris clump of seed 003 figure 3.6 with the solid volume of a sphere of ``diameter``
+    """Debris clump of Lu (2018) figure 3.6 with the solid volume of a sphere of ``diameter``
     (m): union volume ``pi d^3 / 6`` (worn volume -> debris mass is conserved).
 
     Shapes (figure 3.6 gives pictures only; tribodem's choice): ``"spherical"`` one

@@ -374,7 +374,7 @@ class Simulation:
 
     Parameters: particles, materials (indexed by ``particles.mat`` and wall
     ``material``), box (periodic axes), walls, gravity (m/s^2), ``dt`` (s; ``None`` =
-    ``dt_safety`` x critical step), ``viscous_damping`` c (1/s, seed 000 eq 1 eta = c m),
+    ``dt_safety`` x critical step), ``viscous_damping`` c (1/s, Sha et al. (2022) eq 1 eta = c m),
     ``local_damping`` alpha (PFC), ``skin`` (m; default 0.2 x mean radius).
     A ``dt`` above the critical step is refused (``TimeStepError``) unless ``force_dt``.
     ``compiled_loop``: run steps in the compiled multi-step loop when every piece allows

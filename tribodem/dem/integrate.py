@@ -1,4 +1,4 @@
-"""Central-difference integrator with damping (seed 000 eqs 1-8) and time-step estimates.
+"""Central-difference integrator with damping (Sha et al. (2022) eqs 1-8) and time-step estimates.
 
 ``advance`` is the per-particle half of a step (forces gathered, walls, update).
 Velocity form of eqs 4-8 (leapfrog): ``(m + eta dt/2) v+ = (m - eta dt/2) v- + F dt`` and
@@ -46,7 +46,7 @@ def drift_of(pos, ref_pos, radius, ref_radius, i, length, periodic):
 
 @njit(cache=True, inline="always")
 def _update(pos, vel, omega, i, f0, f1, f2, t0, t1, t2, m, inertia, fixed, a, b, local, dt):
-    """Central-difference update of particle i for force f and moment t (seed 000 eqs 4, 7)
+    """Central-difference update of particle i for force f and moment t (Sha et al. (2022) eqs 4, 7)
     with DOF fixity and PFC local damping; scalars, so the sums stay in registers. A free
     particle without local damping takes ``advance``'s own written-out paths instead."""
     for k in range(3):
@@ -195,7 +195,7 @@ def advance_block(pos, vel, omega, radius, mass, inertia, fixed, wstart, wforce,
 
 def rayleigh_step(radius: float | np.ndarray, density: float | np.ndarray, shear_modulus: float,
                   poisson: float) -> float | np.ndarray:
-    """Rayleigh time step (s), seed 003 eq 2.17: pi R sqrt(rho/G) / (0.163 nu + 0.8766).
+    """Rayleigh time step (s), Lu (2018) eq 2.17: pi R sqrt(rho/G) / (0.163 nu + 0.8766).
 
     Works element-wise on arrays of radii and densities.
     """

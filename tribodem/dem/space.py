@@ -1,4 +1,4 @@
-"""The simulation box: bounds and periodic axes (seed 000 fig. 7 remapping)."""
+"""The simulation box: bounds and periodic axes (Sha et al. (2022) fig. 7 remapping)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Rigid first-body surfaces from height maps (seed 003 section 3.2.6: first bodies rigid
+"""Rigid first-body surfaces from height maps (Lu (2018) section 3.2.6: first bodies rigid
 in the DE phase), with prescribed or servo (force-controlled) motion.
 
 A :class:`HeightMapSurface` is the surface ``z = z0 + heights(x - x0, y - y0)`` of a rigid
@@ -14,7 +14,7 @@ Coulomb friction, rolling resistance), with a shear history per particle.
 
 Motion reuses :class:`tribodem.dem.walls.PlaneWall`'s modes: ``point`` is the rigid
 displacement of the map (m), ``normal`` is the direction towards the particles (+z below,
--z above), ``"boundary"`` is the boundary-moving servo of seed 003 eqs 3.2-3.6.
+-z above), ``"boundary"`` is the boundary-moving servo of Lu (2018) eqs 3.2-3.6.
 """
 
 from __future__ import annotations
@@ -93,7 +93,7 @@ def bilinear_weights(x: NDArray[np.float64], y: NDArray[np.float64], x0: float, 
                      ) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.float64]]:
     """Node indices (i, j: [m, 4]) and weights ([m, 4]) of points in a regular grid.
 
-    For a value field this is seed 003 eq 3.15 (the shape function through the element's
+    For a value field this is Lu (2018) eq 3.15 (the shape function through the element's
     four nodal values evaluated at (x, y)); points outside the grid get zero weights.
     """
     u = (np.asarray(x, float) - x0) / dx

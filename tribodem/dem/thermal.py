@@ -1,4 +1,5 @@
-"""Thermal room (seed 000 section 2.4, eq 13; PFC thermal): temperature, expansion, conduction.
+"""Thermal room (Sha et al. (2022) section 2.4, eq 13; PFC thermal): temperature, expansion,
+conduction.
 
 Per particle: temperature T (K), heat capacity c (J/(kg K)), linear expansion alpha (1/K).
 Each step (an engine ``Interaction``; it adds no force itself):
@@ -10,7 +11,7 @@ Each step (an engine ``Interaction``; it adds no force itself):
    interpolated at the end of the step;
 3. the temperature change since the last update expands the particles freely,
    ``dR = alpha R dT`` (mass kept: the density is scaled), and loads the intact bonds with
-   the constrained part, ``dFn = kn A alpha L dT`` (+ = compression; seed 000 eq 13
+   the constrained part, ``dFn = kn A alpha L dT`` (+ = compression; Sha et al. (2022) eq 13
    ``dsigma = E alpha dT`` on the bond section), alpha and dT the means of the two ends.
 
 Heat reaching a particle changes its temperature only; there is no heat of friction here.

@@ -1,4 +1,4 @@
-"""Rigid triangle-mesh surfaces (first bodies from STL, seed 003 section 3.2.6), with
+"""Rigid triangle-mesh surfaces (first bodies from STL, Lu (2018) section 3.2.6), with
 prescribed or servo (force-controlled) motion.
 
 A :class:`TriangleSurface` is a rigid set of triangles (``(n, 3, 3)``, m, in its own frame)
@@ -22,7 +22,7 @@ The grid is rebuilt when a particle radius exceeds ``reach``. Periodic images of
 are not searched: give the mesh the extent the particles can reach.
 
 Motion reuses :class:`tribodem.dem.walls.PlaneWall`'s modes (``"fixed"``, ``"velocity"``,
-``"servo"``, ``"boundary"`` = seed 003 eqs 3.2-3.6, along ``normal``, the direction towards
+``"servo"``, ``"boundary"`` = Lu (2018) eqs 3.2-3.6, along ``normal``, the direction towards
 the particles); or ``path(t) -> displacement (m)`` prescribes the displacement exactly.
 """
 

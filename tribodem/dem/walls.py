@@ -7,7 +7,7 @@ through the same contact laws as particles (wall radius and mass infinite).
 Servo modes (the wall moves along its normal, i.e. towards the particles):
 - ``"servo"`` (PFC): ``v = G (F_target - F_int)``, ``G = alpha / (sum kn dt)``,
   alpha = 0.25 (the Hertz dashpot stiffens the wall response; PFC's usual 0.5 rang);
-- ``"boundary"`` (seed 003 eqs 3.2-3.6, boundary-moving method):
+- ``"boundary"`` (Lu (2018) eqs 3.2-3.6, boundary-moving method):
   ``a = (F_target - F_int - C v) / M``, ``v += a dt``, ``d = v dt``.
 F_int is the normal force the particles press on the wall (N, compressive +).
 """
@@ -29,7 +29,7 @@ WALL_MODES = ("fixed", "velocity", "servo", "boundary")
 class PlaneWall:
     """A plane wall (SI). ``target_force`` (N) is used by the servo modes.
 
-    ``servo_mass`` (kg) and ``servo_damping`` (N s/m) are M and C_c of seed 003 eq 3.6;
+    ``servo_mass`` (kg) and ``servo_damping`` (N s/m) are M and C_c of Lu (2018) eq 3.6;
     ``servo_gain_alpha`` is the PFC gain factor; ``max_speed`` caps servo speed (m/s).
     """
 

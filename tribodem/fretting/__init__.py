@@ -9,8 +9,8 @@ From Python::
     result.to_dataframe()          # results.csv: one row per cycle
     result.summary["wear_volume_lower_m3"]
 
-:func:`run` (one fretting run), :func:`study` (seed 003 chapter 6),
-:func:`debris_study` (seed 003 section 5.4) and :func:`sweep` (a table of runs on Dask)
+:func:`run` (one fretting run), :func:`study` (Lu (2018) chapter 6),
+:func:`debris_study` (Lu (2018) section 5.4) and :func:`sweep` (a table of runs on Dask)
 take a config as a :class:`FrettingConfig`, a dict shaped like the TOML file, a TOML path
 or None, and return a :class:`~tribodem.io.record.RunResult`. See ``docs/fretting.md``
 section "The wear loop".

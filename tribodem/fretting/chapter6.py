@@ -1,4 +1,4 @@
-"""``tribodem fretting study``: seed 003 chapter 6 (the criteria study) as one call,
+"""``tribodem fretting study``: Lu (2018) chapter 6 (the criteria study) as one call,
 :func:`study`.
 
 Chapter 6 runs the seed's case (crossed 8 mm EN24T cylinders, 100 N, the 0.6 mm stroke) with
@@ -219,7 +219,7 @@ def write_markdown(out: Path, rows: list[dict[str, Any]], table: list[dict[str, 
                    order: list[str], solver: str) -> Path:
     """``study.md``: the stages, every seed number beside ours, the two orderings."""
     um = 1e6
-    lines = [f"# Seed 003 chapter 6 criteria study (solver = {solver!r})", "",
+    lines = [f"# Lu (2018) chapter 6 criteria study (solver = {solver!r})", "",
              "| stage | cycles (simulated) | mean scar depth lower / upper (um) | max depth "
              "lower / upper (um) | per cycle, lower (um) | SWT cycles to first wear "
              "lower / upper | wall s |", "|---|---|---|---|---|---|---|"]
@@ -341,7 +341,7 @@ def study(config: ConfigSource = None, out: str | os.PathLike[str] | None = None
           solver: str | None = None, stages: Sequence[str] | str | None = None,
           overrides: Mapping[str, Any] | None = None, echo: Echo | None = None
           ) -> RunResult:
-    """Seed 003 chapter 6 into folder ``out``: every stage (von Mises, S22, DFDI, SWT one
+    """Lu (2018) chapter 6 into folder ``out``: every stage (von Mises, S22, DFDI, SWT one
     cycle; shear and energy 30; shear with jumping 110; ``quick``: 64^2, 5 and 15 cycles)
     a fretting run of the case in ``out/<stage>/``, then ``study.json``, ``study.md`` and
     ``study.csv`` (one row per stage).

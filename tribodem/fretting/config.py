@@ -237,7 +237,7 @@ class WearConfig(StrictModel):
 
 
 class JumpConfig(StrictModel):
-    """Cycle-jumping: a strategy of seed 003 chapter 4 and its parameters, capped by the
+    """Cycle-jumping: a strategy of Lu (2018) chapter 4 and its parameters, capped by the
     loop's geometry control (docs/fretting.md, "Jumping")."""
 
     strategy: JumpName = "none"
@@ -248,7 +248,7 @@ class JumpConfig(StrictModel):
 
 
 class DebrisConfig(StrictModel):
-    """The debris third body (seed 003 3.2.6-3.2.7); off unless ``every`` is set."""
+    """The debris third body (Lu (2018) 3.2.6-3.2.7); off unless ``every`` is set."""
 
     every: int | None = Field(None, ge=1, description="DE phase every K cycles (None: off)")
     diameter: float = Field(0.6e-6, gt=0, **physical(

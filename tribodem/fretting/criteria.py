@@ -1,4 +1,4 @@
-"""Material evolution criteria as plug-ins (seed 003 table 3.3, chapter 6; eq 2.6).
+"""Material evolution criteria as plug-ins (Lu (2018) table 3.3, chapter 6; eq 2.6).
 
 Each criterion turns one simulated fretting cycle into a wear depth map (m) per body:
 the upper body's spot grid ``[n, n]`` and the lower body's track grid ``[n_track, n]``

@@ -1,4 +1,4 @@
-"""The debris third body of the FE-DE fretting model (seed 003 sections 3.2.6-3.2.7, 5.4).
+"""The debris third body of the FE-DE fretting model (Lu (2018) sections 3.2.6-3.2.7, 5.4).
 
 Per generation the worn volume of both bodies becomes debris particles (eq 3.10, N_d =
 V / (pi d^3 / 6), d = 0.6 um, the fractional remainder carried to the next generation so
@@ -60,7 +60,7 @@ SHAPES = DEBRIS_SHAPES  # spherical, chunk, rubbing (seed figure 3.6; tribodem.d
 
 @dataclass(frozen=True)
 class DebrisSettings:
-    """Debris and DE-phase parameters (SI; seed 003 section 3.2.6 defaults)."""
+    """Debris and DE-phase parameters (SI; Lu (2018) section 3.2.6 defaults)."""
 
     diameter: float = 0.6e-6  #: volume-equivalent diameter d of eq 3.10, m
     shares: tuple[float, float, float] = (1 / 3, 1 / 3, 1 / 3)  #: spherical, chunk, rubbing

@@ -1,4 +1,4 @@
-"""``tribodem fretting debris-study``: seed 003 section 5.4 (figures 5.22-5.27) as one call,
+"""``tribodem fretting debris-study``: Lu (2018) section 5.4 (figures 5.22-5.27) as one call,
 :func:`debris_study`.
 
 The study: run the fretting case (default: the energy case, crossed 8 mm cylinders, 100 N)
@@ -318,7 +318,7 @@ def load_count(out: Path, count: int
 
 
 def assumptions(cycle: int) -> dict[str, str]:
-    """Which reading of seed 003 section 5.4 ran (also in docs/debris.md)."""
+    """Which reading of Lu (2018) section 5.4 ran (also in docs/debris.md)."""
     return {
         "cycle": f"the debris is loaded on the geometry worn by {cycle} cycles without debris "
                  "(the seed's figures 5.24-5.27 are at its 160th cycle of the coupled run)",
@@ -353,7 +353,7 @@ def debris_study(config: ConfigSource = None, out: str | os.PathLike[str] | None
                  counts: Sequence[int] | str | None = None, cycle: int | None = None,
                  quick: bool = False, resume: bool = False, progress: bool = False,
                  threads: int | None = None, echo: Echo | None = None) -> RunResult:
-    """Seed 003 section 5.4 into folder ``out``: the case worn without debris to ``cycle``
+    """Lu (2018) section 5.4 into folder ``out``: the case worn without debris to ``cycle``
     (``out/wear/``), then at the loading position the contact force on the lower body
     without and with each count of debris particles; writes ``debris_study.csv`` (one row
     without debris, then one per count), ``debris_study.json``, profiles and plots.

@@ -1,4 +1,4 @@
-"""The fretting wear loop (seed 003 figure 3.1 without debris; sections 3.3.3, 6.3).
+"""The fretting wear loop (Lu (2018) figure 3.1 without debris; sections 3.3.3, 6.3).
 
 Per simulated cycle: move the upper body through 0 -> +A -> 0 -> -A -> 0 with the first-body
 solver on the *current* worn surfaces, stream every increment to the criterion, get the
@@ -45,7 +45,7 @@ RESULT_COLUMNS = (
     "max_traction_Pa",
     "contact_area_m2",
 )
-#: Extra columns when the debris third body is on (seed 003 sections 3.2.6-3.2.7).
+#: Extra columns when the debris third body is on (Lu (2018) sections 3.2.6-3.2.7).
 DEBRIS_COLUMNS = (
     "debris_particles",
     "debris_load_fraction",
@@ -237,7 +237,7 @@ class FrettingLoop:
         self._keep: set[int] = set()  # cycles whose profiles stay recorded
 
     def _de_phase(self) -> dict[str, float]:
-        """Seed 003 figure 3.1 DE step: load the debris, map its forces back to the solver."""
+        """Lu (2018) figure 3.1 DE step: load the debris, map its forces back to the solver."""
         d, sol = self.debris, self.solver
         assert d is not None
         c = sol.coords

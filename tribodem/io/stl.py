@@ -1,7 +1,7 @@
 """STL triangle meshes (ASCII and binary, read and written by meshio) and height maps as
 triangles.
 
-Seed 003 (section 3.2.6) exchanges the first-body geometry between the FE and DE phases as
+Lu (2018) (section 3.2.6) exchanges the first-body geometry between the FE and DE phases as
 ``.stl`` files. Triangles are ``(n, 3, 3)`` float arrays (triangle, vertex, xyz; m); the
 vertex order gives the outward normal by the right-hand rule. Binary STL stores float32:
 reading returns those values exactly (as float64). ASCII is written with the shortest

@@ -1,6 +1,7 @@
-"""tribodem.materials: every material once, with sources, and the calibration of seed 000.
+"""tribodem.materials: every material once, with sources, and the calibration of Sha et al. (2022).
 
-``en24t`` (seed 003's first-body steel: tables 5.1, 6.2, section 5.2), ``library`` (seed 000
+``en24t`` (Lu (2018)'s first-body steel: tables 5.1, 6.2, section 5.2), ``library`` (Sha et
+al. (2022)
 tables 1 and 3: ``MaterialSpec``, ``Q345B``, ``CU_PM``), ``specimen`` (bonded specimen
 generation), ``compression`` (uniaxial compression test, eq 12), ``calibration`` (automatic
 E_c / kratio calibration: :func:`calibrate_spec` on a spec, :func:`calibrate` the run of

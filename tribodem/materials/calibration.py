@@ -1,4 +1,5 @@
-"""Automatic calibration of E_c and kratio against E and nu (seed 000 section 3.1, table 2).
+"""Automatic calibration of E_c and kratio against E and nu (Sha et al. (2022) section 3.1,
+table 2).
 
 The uniaxial compression test (``run_compression``, eq 12) is run on ``n_specimens``
 specimens of the seed's size (0.05 x 0.1 mm, seeds ``seed .. seed + n - 1``, packed once;
@@ -44,9 +45,9 @@ from tribodem.materials.compression import CompressionResult, run_compression
 from tribodem.materials.library import MaterialSpec
 from tribodem.materials.specimen import Specimen, make_specimen
 
-TOLERANCE = 0.026  # seed 000 table 2: largest relative error 2.58%
+TOLERANCE = 0.026  # Sha et al. (2022) table 2: largest relative error 2.58%
 KRATIO_RANGE = (0.1, 20.0)
-SPECIMEN_WIDTH = 0.05e-3  # m, seed 000 section 3.1
+SPECIMEN_WIDTH = 0.05e-3  # m, Sha et al. (2022) section 3.1
 SPECIMEN_HEIGHT = 0.1e-3  # m
 
 
@@ -169,7 +170,7 @@ QUICK_MAX_ITER, FULL_MAX_ITER = 8, 15
 TABLE = "history.csv"
 
 ASSUMPTIONS = (
-    "2D disks of unit thickness (1 m); specimen 0.05 x 0.1 mm as seed 000 section 3.1, "
+    "2D disks of unit thickness (1 m); specimen 0.05 x 0.1 mm as Sha et al. (2022) section 3.1, "
     "radii uniform in [3.27, 3.93] um (mean 3.6 um, ratio 1.2) then scaled by ~0.98 to set "
     "the 1 MPa isotropic compaction stress (radius expansion in fixed walls, frictionless, "
     "mass-scaled); floating particles (< 3 contacts, walls included) deleted; parallel bonds "
@@ -193,7 +194,7 @@ def calibrate(material: str, out: str | os.PathLike[str], *, quick: bool = False
               scheduler: str | None = None, progress: bool = False,
               echo: Callable[[str], Any] | None = None) -> RunResult:
     """Calibrate E_c and kratio of library material ``material`` (``"q345b"``, ``"cu-pm"``)
-    by uniaxial compression (seed 000 eq 12) to table 1's E and nu; writes
+    by uniaxial compression (Sha et al. (2022) eq 12) to table 1's E and nu; writes
     ``summary.json``, ``history.csv`` and ``stress_strain.png`` to ``out``.
 
     ``quick``: :data:`QUICK_SPECIMENS` specimens per iteration and at most

@@ -1,4 +1,4 @@
-"""CLI of the materials room: ``tribodem calibrate`` (seed 000 section 3.1, tables 1-3).
+"""CLI of the materials room: ``tribodem calibrate`` (Sha et al. (2022) section 3.1, tables 1-3).
 
 Option parsing only: the calibration run is :func:`tribodem.materials.calibration.calibrate`.
 """

@@ -1,4 +1,4 @@
-"""Uniaxial compression test of a bonded specimen (seed 000 section 3.1, figure 6, eq 12).
+"""Uniaxial compression test of a bonded specimen (Sha et al. (2022) section 3.1, figure 6, eq 12).
 
 Two frictionless platens (velocity walls) move towards the centre at ``platen_speed``
 (default the seed's 0.1 m/s each: strain rate 2 v / H = 2000 1/s for H = 0.1 mm, i.e.
@@ -182,7 +182,7 @@ def plot_stress_strain(res: CompressionResult, path: str | Path, title: str = ""
     h1, l1 = ax.get_legend_handles_labels()
     h2, l2 = ax2.get_legend_handles_labels()
     ax.legend(h1 + h2, l1 + l2, loc="lower right", fontsize=8)
-    ax.set_title(title or "uniaxial compression (seed 000 fig 6, eq 12)")
+    ax.set_title(title or "uniaxial compression (Sha et al. (2022) fig 6, eq 12)")
     fig.tight_layout()
 
     return write_figure(path, fig)

@@ -1,6 +1,6 @@
-"""EN24T, the first-body steel of seed 003 (crossed cylinders), defined once.
+"""EN24T, the first-body steel of Lu (2018) (crossed cylinders), defined once.
 
-Sources, all seed 003: table 5.1 (E, nu, yield, UTS; bilinear hardening), section 5.2 (the
+Sources, all Lu (2018): table 5.1 (E, nu, yield, UTS; bilinear hardening), section 5.2 (the
 Fouvry energy wear coefficient of the fretting tests), table 6.2 (Smith-Watson-Topper
 constants by Mitchell's method; its true UTS 1132 MPa = 1000 MPa x (1 + e) fixes the
 engineering strain at the UTS), appendix IV (the DFDI script's eps0 = 0.118). SI units.
@@ -38,6 +38,6 @@ EN24T = SolidMaterial(
     energy_wear_coefficient=1.641e-6 * 1e-9,  # 1.641e-6 mm^3/J
     swt={"b": -0.103, "sigma_f": 2349e6, "sigma_t": 1132e6, "eps_f": 1.22, "c": -0.6},
     dfdi_eps0=0.118,  # the seed's DFDI script (appendix IV: FailE = 1.65*0.118*exp(...))
-    source="seed 003 table 5.1 (elastic-plastic), section 5.2 (alpha), table 6.2 (SWT), "
+    source="Lu (2018) table 5.1 (elastic-plastic), section 5.2 (alpha), table 6.2 (SWT), "
     "appendix IV (DFDI eps0)",
 )

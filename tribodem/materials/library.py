@@ -1,4 +1,4 @@
-"""Micro-parameter sets of the braking materials (seed 000 tables 1 and 3).
+"""Micro-parameter sets of the braking materials (Sha et al. (2022) tables 1 and 3).
 
 Macro targets (table 1) are what the uniaxial compression test must reproduce (eq 12);
 micro-parameters (table 3) feed the linear contact law (PFC deformability,
@@ -125,11 +125,11 @@ class MaterialSpec:
                 "density_kg_m3": self.density}
 
 
-#: brake disc, Q345B steel (seed 000 tables 1 and 3)
+#: brake disc, Q345B steel (Sha et al. (2022) tables 1 and 3)
 Q345B = MaterialSpec(name="q345b", density=7850.0, young=201e9, poisson=0.302,
                      effective_modulus=9.35e10, kratio=1.75, tensile_strength=440e6,
                      cohesion=440e6, expansion=9.5e-6)
-#: brake pad, copper-based powder metallurgy (seed 000 tables 1 and 3)
+#: brake pad, copper-based powder metallurgy (Sha et al. (2022) tables 1 and 3)
 CU_PM = MaterialSpec(name="cu-pm", density=5250.0, young=178e9, poisson=0.294,
                      effective_modulus=8.45e10, kratio=1.75, tensile_strength=245e6,
                      cohesion=245e6, expansion=1.11e-5)

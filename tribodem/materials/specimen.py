@@ -1,4 +1,4 @@
-"""Bonded-particle specimen generation (seed 000 section 3.1, figure 4).
+"""Bonded-particle specimen generation (Sha et al. (2022) section 3.1, figure 4).
 
 Procedure (2D disks of unit thickness):
 
@@ -44,7 +44,7 @@ from tribodem.materials.library import MaterialSpec
 PHI_TARGET = 0.82  # 2D area fraction of the particle count (before the stress adjustment)
 PHI0 = 0.35  # initial area fraction of the random placement
 MASS_SCALE = 1.0e4  # density multiplier during compaction only (quasi-static, geometry only)
-MIN_CONTACTS = 3  # seed 000 section 3.1 (2): floating particles have fewer contacts
+MIN_CONTACTS = 3  # Sha et al. (2022) section 3.1 (2): floating particles have fewer contacts
 
 
 @dataclass
@@ -171,7 +171,7 @@ def contact_counts(pos: np.ndarray, radius: np.ndarray, gap: float, width: float
 
 def prune_floating(pos: np.ndarray, radius: np.ndarray, gap: float, width: float,
                    height: float, min_contacts: int = MIN_CONTACTS) -> np.ndarray:
-    """Mask of the particles kept (seed 000 3.1 (2), PFC's floater test, one pass): delete
+    """Mask of the particles kept (Sha et al. (2022) 3.1 (2), PFC's floater test, one pass): delete
     those with fewer than ``min_contacts`` contacts (walls included) in the compacted
     state, then (repeatedly) those left without any bondable neighbour."""
     keep = contact_counts(pos, radius, gap, width, height) >= min_contacts

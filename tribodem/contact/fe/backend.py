@@ -1,6 +1,6 @@
 """``fe``: the CalculiX finite-element first body behind the first-body contract (docs/fe.md).
 
-A 2D plane-strain cylindrical pad on a flat (a line contact, seed 003 sections 3.2-3.3 with
+A 2D plane-strain cylindrical pad on a flat (a line contact, Lu (2018) sections 3.2-3.3 with
 the seed's 3D crossed cylinders replaced by their plane-strain section). Mode ``fresh`` (the
 seed's way, section 3.3): every fretting cycle is one ccx job on the current worn geometry,
 starting from virgin, unloaded bodies: seating, the normal load, then the cycle

@@ -1,6 +1,6 @@
 """``fe3d``: the 3D CalculiX crossed-cylinder first body behind the contract (docs/fe3d.md).
 
-The seed's geometry (seed 003 figure 3.4): two crossed cylinders of equal radius R, the upper
+The seed's geometry (Lu (2018) figure 3.4): two crossed cylinders of equal radius R, the upper
 one's axis along y, the lower one's along x, the stroke along x (a point contact). The mesh is
 :func:`tribodem.contact.fe.crossed.crossed_mesh`'s *half* model (y >= 0, symmetry u_y = 0 on
 y = 0; the stroke breaks the x = 0 symmetry): 8-node bricks on straight vertical node columns,
@@ -631,7 +631,7 @@ class FE3DContactSolver(CcxBackend[Mesh3D]):
         """Whether the next job primes its cycle (mode ``primed``, from the second cycle)."""
         return self.mode == "primed" and self._cycle >= 1
 
-    # -- debris third body (seed 003 section 3.2.7: forces mapped back) --------------------
+    # -- debris third body (Lu (2018) section 3.2.7: forces mapped back) --------------------
     def set_debris_pressure(self, pressure: NDArray[np.float64] | None) -> None:
         """Prescribe the debris pressure on the window (the upper body's frame at offset 0),
         Pa [n, n] (None clears). The next job loads both contact faces with it, as a face

@@ -1,4 +1,4 @@
-"""3D crossed-cylinder model on CalculiX (seed 003 figure 3.4): quarter model.
+"""3D crossed-cylinder model on CalculiX (Lu (2018) figure 3.4): quarter model.
 
 Geometry (SI, metres): the *upper* cylinder's axis is along y, the *lower* cylinder's along x
 (the stroke is along x); they touch at the origin, z up. Under a normal load the problem has

@@ -1,4 +1,4 @@
-"""CalculiX input deck of the plane-strain pad-on-flat fretting model (seed 003 section 3.2.5).
+"""CalculiX input deck of the plane-strain pad-on-flat fretting model (Lu (2018) section 3.2.5).
 
 Model (SI units; per unit length: the plane-strain thickness is 1 m, so forces are N/m):
 

@@ -31,7 +31,7 @@ class FEOptions(StrictModel):
 
     mode: Literal["fresh", "chained", "primed"] = Field(
         "fresh", description="fresh: one ccx job per cycle on the worn geometry, virgin "
-        "material (seed 003 section 3.3); chained (fe): cycles continue in one job while the "
+        "material (Lu (2018) section 3.3); chained (fe): cycles continue in one job while the "
         "geometry is unchanged, so plastic strain and residual stress carry over; primed "
         "(fe3d): each job from cycle 2 first runs the previous cycle's second half, so the "
         "served cycle is a continuous test's (the steady loop of elastic bodies)")

@@ -5,7 +5,7 @@ micrometres between neighbouring node columns; on the seed's shear run at h = a/
 surfaces stepped by up to 10.6 um between columns 44 um apart (slope 0.24) after two
 cycles, and ccx's node-to-surface contact no longer converged on them (docs/fe3d.md
 "Worn geometry"). The seed itself, for its FDEM comparison, replaced the worn and
-irregular surface "with a smoothed profile of the same wear depth" (seed 003 section 5).
+irregular surface "with a smoothed profile of the same wear depth" (Lu (2018) section 5).
 
 :func:`limit_slope` relaxes the nodal worn depths until no step between neighbouring
 columns (along x or along y) is steeper than ``slope``: every edge whose step exceeds

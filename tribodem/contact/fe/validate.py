@@ -2,7 +2,7 @@
 
 Each check is a dict ``{"name", "value", "reference", "error", "tolerance", "pass"}``;
 ``error`` is relative (``|value - reference| / |reference|``) unless the name says "(m)".
-References (K. L. Johnson, Contact Mechanics, 1985; seed 003 section 3.2.5):
+References (K. L. Johnson, Contact Mechanics, 1985; Lu (2018) section 3.2.5):
 
 * Hertz line contact (eq. 4.45): p0 = sqrt(P E* / (pi R)), a = sqrt(4 P R / (pi E*)).
 * Cattaneo-Mindlin line contact (section 7.2): stick zone c / a = sqrt(1 - Q / (mu P)).

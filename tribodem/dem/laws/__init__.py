@@ -4,7 +4,7 @@ A law module defines
 
 - ``NAME`` (str): what ``Material(law=...)`` names;
 - ``TIME_STEP``: ``"stiffness"`` (critical step ``sqrt(m/k)`` from the normal and shear
-  stiffness, PFC) or ``"rayleigh"`` (seed 003 eq 2.17);
+  stiffness, PFC) or ``"rayleigh"`` (Lu (2018) eq 2.17);
 - ``normal(prop, delta, vn, rstar, mstar, lin_k) -> (fn, kt, ct, kn, energy)``, a
   ``numba.njit(inline="always")`` function: normal force (N, + = repulsive), tangential
   stiffness (N/m) and damping (N s/m), normal stiffness (N/m), stored normal energy (J) at

@@ -1,8 +1,8 @@
-"""Hertz-Mindlin (no slip) contact law, as EDEM and LIGGGHTS (seed 003 section 2.3).
+"""Hertz-Mindlin (no slip) contact law, as EDEM and LIGGGHTS (Lu (2018) section 2.3).
 
 ``Fn = 4/3 E* sqrt(R*) d^1.5``, ``Sn = 2 E* sqrt(R* d)``, ``St = 8 G* sqrt(R* d)``, dashpots
 ``gamma sqrt(S m*)`` with gamma from the coefficient of restitution
-(``contact.hertz_damping_from_cor``). Time step: the Rayleigh step (seed 003 eq 2.17).
+(``contact.hertz_damping_from_cor``). Time step: the Rayleigh step (Lu (2018) eq 2.17).
 """
 
 from __future__ import annotations

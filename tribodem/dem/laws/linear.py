@@ -1,4 +1,4 @@
-"""Linear contact law (PFC "deformability" style; seed 000 table 3).
+"""Linear contact law (PFC "deformability" style; Sha et al. (2022) table 3).
 
 ``kn = A / (r_i/E_i + r_j/E_j)`` -- for equal moduli ``A E / (r_i + r_j)`` -- with
 ``A = 2 r_min t`` (2D) or ``pi r_min^2`` (3D), computed by the caller as ``lin_k``;
