@@ -1,13 +1,14 @@
-"""Cycle-jumping under noise: the ``adaptive`` default against ``smooth`` (for docs/cyclejump.md).
+"""Cycle-jumping under noise: the ``adaptive`` default against ``polynomial`` (docs/cyclejump.md).
 
 Series: ``tribodem.cyclejump.synthetic_smooth_series(shape, n, noise, seed)`` with the
 shapes linear, power (h ~ N^0.5), exponential (run-in 10x steady decaying over n/10
 cycles) and two_phase (the same law with tau = 50). The noise is Gaussian multiplicative,
 per cycle. The noisy rows use seeds 0..S-1; the noise-free rows use one series.
 
-Strategies: ``make_strategy("adaptive", decide_on="total")`` (what the fretting loop
-builds for ``jump.strategy = "adaptive"``) and ``SmoothJump()``
-(tribodem/cyclejump/smooth.py), both on their defaults (tol 1 %).
+Strategies: ``make_strategy("adaptive")`` (:class:`~tribodem.cyclejump.SmoothJump`, the
+step control on a fitted curve: what the fretting loop builds for ``jump.strategy =
+"adaptive"``) and ``make_strategy("polynomial", decide_on="total")`` (the thesis' adaptive
+polynomial strategy, the default before), both on their defaults (tol 1 %).
 
 Prints one Markdown row per shape x n x noise: cycles saved % (mean, smallest over the
 seeds) and final relative error % (mean, largest), then the mean wall time of one replay.
@@ -35,11 +36,10 @@ from tribodem.cyclejump import (  # noqa: E402
     replay,
     synthetic_smooth_series,
 )
-from tribodem.cyclejump.smooth import SmoothJump  # noqa: E402
 
 STRATEGIES: list[tuple[str, Callable[[], JumpStrategy]]] = [
-    ("adaptive", lambda: make_strategy("adaptive", decide_on="total")),
-    ("smooth", SmoothJump),
+    ("polynomial", lambda: make_strategy("polynomial", decide_on="total")),
+    ("adaptive", lambda: make_strategy("adaptive")),
 ]
 
 

@@ -17,7 +17,8 @@ STEEL = dict(young=2.1e11, poisson=0.3, density=7850.0)
 #: collection order) gives a short makespan (Graham's LPT rule).
 FILE_SECONDS = {
     "test_fe_backend3d_runs.py": 147, "test_fe_backend3d.py": 118, "test_cli_errors.py": 89,
-    "test_braking.py": 67, "test_fe.py": 65, "test_faults.py": 55, "test_fe_backend.py": 45,
+    "test_braking.py": 67, "test_fe.py": 65, "test_outputs.py": 60, "test_faults.py": 55,
+    "test_fe_backend.py": 45,
     "test_fretting_resume.py": 43, "test_fretting_geometry.py": 38,
     "test_braking_dask.py": 36, "test_braking_resume.py": 33, "test_cli_resume.py": 28,
     "test_fretting_line.py": 25, "test_fretting_jump.py": 25, "test_fretting_sweep.py": 24,

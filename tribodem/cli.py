@@ -41,8 +41,14 @@ def _version(value: bool) -> None:
 def _root(
     version: bool = typer.Option(False, "--version", callback=_version, is_eager=True,
                                  help="Print the version and exit."),
+    verbose: int = typer.Option(0, "--verbose", "-v", count=True,
+                                help="More messages on stderr (-vv: the libraries' too)."),
+    quiet: bool = typer.Option(False, "--quiet", "-q", help="Only warnings and errors."),
 ) -> None:
     """tribodem: wear at contact interfaces with particles."""
+    from tribodem.io.logs import configure
+
+    configure(-1 if quiet else verbose)
 
 
 #: Sub-commands: name -> (module, attribute, a typer group or a single command).

@@ -1,4 +1,4 @@
-"""``tribodem braking run`` and ``tribodem braking sweep`` (Sha et al. (2022), Sha et al. 2022:
+"""``tribodem braking run`` and ``tribodem braking sweep`` (Sha et al. (2022):
 sections 3.2-5, table 4): the options parsed, then :func:`tribodem.braking.run` /
 :func:`tribodem.braking.sweep` called and their result printed.
 
@@ -21,7 +21,8 @@ from tribodem.braking.conditions import CONDITIONS
 from tribodem.io.config import ConfigError, parse_int_list
 from tribodem.io.helptext import reflowed
 
-braking_app = typer.Typer(help="Braking interface wear model (Sha et al. 2022, Lubricants).",
+braking_app = typer.Typer(help="Braking interface wear model (Sha et al. (2022), "
+                          "Lubricants).",
                           no_args_is_help=True)
 
 #: what ``braking run`` prints of the summary
@@ -40,7 +41,7 @@ def braking_run(
                              "replaced unless --resume)."),
     condition: int | None = typer.Option(
         None, "--condition",
-        help="Braking condition 1..5: load and speed of table 4 of Sha et al. 2022."),
+        help="Braking condition 1..5: load and speed of table 4 of Sha et al. (2022)."),
     config: Path | None = typer.Option(None, "--config", help="TOML config file."),
     quick: bool = typer.Option(False, "--quick", help="Small, fast variant (< 3 min); it "
                                "overrides the config file, --condition overrides both."),
@@ -97,7 +98,7 @@ def braking_sweep(
                                      help="Deprecated alias of --packings."),
     conditions: str | None = typer.Option(
         None, "--conditions",
-        help="Which conditions (table 4 of Sha et al. 2022) to run, e.g. 1,3,5 (the two "
+        help="Which conditions (table 4 of Sha et al. (2022)) to run, e.g. 1,3,5 (the two "
              "end-to-end trends, 13 -> 21 kN and 800 -> 1200 r/min, at 3/5 of the cost); "
              "changes needing an absent condition are left unevaluated. Default: all five."),
     workers: int = typer.Option(
@@ -115,7 +116,7 @@ def braking_sweep(
 ) -> None:
     """Conditions 1-5 (or --conditions) x --packings on Dask: comparison.md,
     comparison.json, comparison.csv (ours with paired 95% intervals beside the paper's,
-    Sha et al. 2022 section 5), members.csv (one row per member).
+    Sha et al. (2022) section 5), members.csv (one row per member).
 
     Each (condition, packing) member is an independent, idempotent task with its own
     folder and checkpoints; a re-run with the same --out skips the finished members,

@@ -23,14 +23,14 @@ from tribodem.io import runs
 from tribodem.io.config import ConfigError
 from tribodem.io.helptext import reflowed
 
-fretting_app = typer.Typer(help="Fretting wear loop (Lu 2018, PhD thesis, Exeter: chapters "
-                                "5-6).",
+fretting_app = typer.Typer(help="Fretting wear loop (Lu (2018), PhD thesis, "
+                                "Exeter: chapters 5-6).",
                            no_args_is_help=True, add_completion=False)
 
 
 @fretting_app.callback()
 def _fretting() -> None:
-    """Fretting wear loop (Lu 2018, PhD thesis, Exeter: chapters 5-6)."""
+    """Fretting wear loop (Lu (2018), PhD thesis, Exeter: chapters 5-6)."""
 
 
 def run_overrides(criterion: str | None, cycles: int | None, jump: str | None,
@@ -125,7 +125,7 @@ def study_cmd(
     progress: Annotated[bool, typer.Option(
         "--progress/--no-progress", help="Progress bars of the runs on stderr.")] = True,
 ) -> None:
-    """The criteria study of Lu 2018 (thesis chapter 6): every material evolution criterion
+    """The criteria study of Lu (2018) (thesis chapter 6): every material evolution criterion
     on one case (one cycle for von Mises, S22, DFDI, SWT; 30 for shear and energy; shear
     with jumping to 110), the thesis's numbers beside ours and the criteria ordered
     (study.md, study.json).
@@ -160,7 +160,7 @@ def debris_study_cmd(
     progress: Annotated[bool, typer.Option(
         "--progress/--no-progress", help="Progress bar of the wear run on stderr.")] = True,
 ) -> None:
-    """Debris as a third body (Lu 2018, thesis section 5.4): the contact force on the lower
+    """Debris as a third body (Lu (2018), thesis section 5.4): the contact force on the lower
     body at a cycle, without and with N debris particles (thesis figs 5.22-5.27); writes
     debris_study.{csv,json}, plots, per-count data."""
     summary = debris_study(config, out, counts=counts, cycle=cycle, quick=quick,

@@ -217,8 +217,8 @@ def write_vtk_surfaces(hist: FrettingHistory, out: Path) -> list[Path]:
 def debris_layer_figure(ph: Any) -> Any:
     """``debris_layer.png``'s figure of DE phase ``ph`` (a :class:`DEPhaseResult`): the
     particles coloured by the force on each (mN) and by the distance moved in the loading
-    step (nm), each with its colour bar; a constrained layout keeps the titles clear of the
-    colour bars."""
+    step (nm), each with its colour bar below it (a layer is wider than long along the
+    stroke); a constrained layout keeps the titles clear of the colour bars."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -226,12 +226,14 @@ def debris_layer_figure(ph: Any) -> Any:
 
     moved = np.linalg.norm(ph.positions - ph.start_positions, axis=1)
     fmag = np.linalg.norm(ph.particle_force, axis=1)
-    fig, axes = plt.subplots(1, 2, figsize=(11, 5), layout="constrained")
+    ext = np.ptp(ph.positions[:, :2], axis=0)  # the figure's height follows the layer's
+    ratio = float(np.clip(ext[1] / ext[0], 0.2, 1.5)) if ext[0] > 0 else 1.0
+    fig, axes = plt.subplots(1, 2, figsize=(11, 2.3 + 4.7 * ratio), layout="constrained")
     for ax, val, lab in ((axes[0], fmag * 1e3, "force on particle (mN)"),
                          (axes[1], moved * 1e9, "moved distance (nm)")):
         sc = ax.scatter(ph.positions[:, 0] * 1e3, ph.positions[:, 1] * 1e3, c=val, s=2,
                         cmap="viridis")
-        fig.colorbar(sc, ax=ax, label=lab, shrink=0.9)
+        fig.colorbar(sc, ax=ax, label=lab, location="bottom", shrink=0.8, aspect=40)
         ax.set_aspect("equal")
         ax.set_xlabel("x (mm)")
         ax.set_ylabel("y (mm)")

@@ -36,10 +36,10 @@ def calibrate(
                                   help="Progress bar (compression tests) with ETA on stderr."),
 ) -> None:
     """Calibrate the bond micro-parameters E_c and kratio so that uniaxial compression of
-    packed specimens gives the material's E and nu (Sha et al. 2022, table 1): writes
+    packed specimens gives the material's E and nu (Sha et al. (2022), table 1): writes
     summary.json, history.csv and stress_strain.png.
 
-    E and nu of a test are Sha et al.'s eq 12: the slopes of the axial stress and of the
+    E and nu of a test are Sha et al. (2022)'s eq 12: the slopes of the axial stress and of the
     lateral strain against the axial strain, fitted between 10 % and 50 % of the peak
     stress. Each iteration's compression tests run one task per specimen on Dask (the same
     results on any number of workers; --workers 1 runs them in this process, without
