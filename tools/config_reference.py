@@ -284,6 +284,8 @@ def table_rows(model: Any, prefix: str) -> tuple[list[str], list[tuple[str, Any]
     filled = filled_in(model)
     for name, f in model.model_fields.items():
         key = f"{prefix}{name}"
+        if f.exclude:  # internal: not written in a config file (e.g. plug-in tables)
+            continue
         if is_model(f.annotation):
             tables.append((key, f.annotation))
             continue
@@ -311,6 +313,8 @@ def undescribed() -> list[str]:
 
     def walk(model: Any, prefix: str) -> None:
         for name, f in model.model_fields.items():
+            if f.exclude:
+                continue
             if is_model(f.annotation):
                 walk(f.annotation, f"{prefix}{name}.")
             elif not f.description:
@@ -475,7 +479,9 @@ def config_page() -> str:
         "`tribodem.fretting.run(config, out)` and the other functions of "
         "`tribodem.fretting`. Each first-body backend reads its own option table "
         "(`[elastic]`, `[plastic]`, `[fe]`); a key of another backend's table set away "
-        "from its default is refused.")
+        "from its default is refused. A backend registered from Python may declare a "
+        "table of its own (`FirstBodySolver.options`), which the config then accepts "
+        "beside these.")
     quick = FrettingConfig.QUICK
     lines += ["### `--quick` (fretting)", "",
               "`--quick` (and `quick=True`) lays these over the config: "
@@ -531,7 +537,16 @@ def cli_page() -> str:
     return "\n".join(lines).rstrip() + "\n"
 
 
-PAGES = {CONFIG_PAGE: config_page, CLI_PAGE: cli_page}
+def without_unused_legend(text: str) -> str:
+    """The page without :data:`LEGEND` when no description names a seed any more."""
+    body = text.replace(LEGEND, "")
+    if "seed 00" in body.lower() or "the seed" in body.lower():
+        return text
+    return text.replace(LEGEND + "\n\n", "")
+
+
+PAGES = {CONFIG_PAGE: lambda: without_unused_legend(config_page()),
+         CLI_PAGE: lambda: without_unused_legend(cli_page())}
 
 
 def main(argv: list[str] | None = None) -> int:
