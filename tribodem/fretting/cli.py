@@ -98,8 +98,13 @@ def run_cmd(
         f"done: {summary['cycles']} cycles ({summary['cycles_simulated']} simulated, "
         f"{summary['cycles_jumped']} jumped) in {summary['wall_time_s']:.1f} s; worn volume "
         f"upper {summary['wear_volume_upper_m3']:.4g} m^3, lower "
-        f"{summary['wear_volume_lower_m3']:.4g} m^3 -> {out}"
+        f"{summary['wear_volume_lower_m3']:.4g} m^3; maximum wear depth upper "
+        f"{summary['wear_depth_upper_m']:.4g} m, lower {summary['wear_depth_lower_m']:.4g} m"
+        f" -> {out}"
     )
+    plots = [f for f in summary.get("files", []) if f.endswith(".png")]
+    if plots:
+        typer.echo(f"plots: {', '.join(str(out / f) for f in plots)}")
 
 
 @fretting_app.command("study")
