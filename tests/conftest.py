@@ -78,6 +78,19 @@ def run_tribodem(*args: str, timeout: float = 600, **kw):  # noqa: ANN201
                           timeout=timeout, **kw)
 
 
+#: summary.json entries that are wall-clock times (never bitwise between two runs)
+TIMING = {"wall_time_s", "wall_time_total_s"}
+
+
+def without_timings(d: object) -> object:
+    """A JSON tree (summary.json) without its wall-clock timings (:data:`TIMING`)."""
+    if isinstance(d, dict):
+        return {k: without_timings(v) for k, v in d.items() if k not in TIMING}
+    if isinstance(d, list):
+        return [without_timings(v) for v in d]
+    return d
+
+
 def default_sigint() -> None:
     """``preexec_fn`` for a child that must take Ctrl-C: a shell without job control starts
     background commands with SIGINT ignored, and Python keeps an inherited SIG_IGN."""

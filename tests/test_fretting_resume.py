@@ -19,7 +19,7 @@ from pathlib import Path
 
 import pytest
 from conftest import before_config_v2 as _before_v2
-from conftest import run_tribodem, tribodem_exe
+from conftest import run_tribodem, tribodem_exe, without_timings
 
 from tribodem.fretting.config import resolve_config
 from tribodem.fretting.runner import run
@@ -28,22 +28,13 @@ from tribodem.io.runs import RunStopped
 
 SMALL = "[output]\nfigures = false\nvtk = false\n"
 CYCLES = "30"
-TIMING = {"wall_time_s", "wall_time_total_s"}
-
-
-def _numbers(d):  # noqa: ANN001, ANN202 - JSON tree without wall-clock timings
-    if isinstance(d, dict):
-        return {k: _numbers(v) for k, v in d.items() if k not in TIMING}
-    if isinstance(d, list):
-        return [_numbers(v) for v in d]
-    return d
 
 
 def _same_outputs(a: Path, b: Path) -> None:
     assert (a / "results.csv").read_bytes() == (b / "results.csv").read_bytes()
     sa = json.loads((a / "summary.json").read_text())
     sb = json.loads((b / "summary.json").read_text())
-    assert _numbers(sa) == _numbers(sb)
+    assert without_timings(sa) == without_timings(sb)
     assert (a / "config.toml").read_bytes() == (b / "config.toml").read_bytes()
 
 

@@ -10,7 +10,7 @@ import json
 from pathlib import Path
 
 import pytest
-from conftest import run_tribodem
+from conftest import run_tribodem, without_timings
 
 import tribodem.fretting
 from tribodem.fretting import RESULT_COLUMNS, FrettingConfig, run
@@ -19,15 +19,6 @@ from tribodem.io.record import RunResult
 
 SMALL = {"contact": {"n": 32, "n_increments": 8},
          "output": {"figures": False, "vtk": False}}
-TIMING = {"wall_time_s", "wall_time_total_s"}
-
-
-def _numbers(d):  # noqa: ANN001, ANN202 - JSON tree without wall-clock timings
-    if isinstance(d, dict):
-        return {k: _numbers(v) for k, v in d.items() if k not in TIMING}
-    if isinstance(d, list):
-        return [_numbers(v) for v in d]
-    return d
 
 
 def _same_run(a: Path, b: Path) -> None:
@@ -36,7 +27,7 @@ def _same_run(a: Path, b: Path) -> None:
         assert (a / name).read_bytes() == (b / name).read_bytes(), name
     sa = json.loads((a / "summary.json").read_text())
     sb = json.loads((b / "summary.json").read_text())
-    assert _numbers(sa) == _numbers(sb)
+    assert without_timings(sa) == without_timings(sb)
 
 
 def test_a_run_from_a_dict_returns_its_table_and_summary(tmp_path: Path) -> None:
