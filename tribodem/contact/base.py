@@ -176,7 +176,10 @@ class Capabilities:
     ``partial_slip``: stick/slip inside the contact (else gross slip q = mu p everywhere);
     ``subsurface``: stress below the surface (:meth:`FirstBodySolver.subsurface_stress`);
     ``debris``: a prescribed extra surface pressure (the debris third body);
-    ``contacts``: the contact geometries it solves (``"point"``, ``"line"``).
+    ``contacts``: the contact geometries it solves (``"point"``, ``"line"``);
+    ``repeatable``: a cycle can be solved again on updated surfaces with no state advancing
+    but the tractions' memory (no plastic strain, no job files): the fretting loop may
+    split a cycle's wear into sub-cycles (``FrettingLoop(update_tolerance=...)``).
     """
 
     plastic: bool = False
@@ -185,6 +188,7 @@ class Capabilities:
     subsurface: bool = True
     debris: bool = False
     contacts: tuple[str, ...] = ("point",)
+    repeatable: bool = False
 
     def names(self) -> set[str]:
         """The capabilities that hold, by name (``plastic``, ``subsurface``, ...)."""

@@ -140,7 +140,7 @@ class HalfSpaceSolver(FirstBodySolver):
 
     name = "elastic"
     capabilities = Capabilities(partial_slip=True, subsurface=True, debris=True,
-                                contacts=("point", "line"))
+                                contacts=("point", "line"), repeatable=True)
     options: ClassVar[dict[str, type[BaseModel]]] = {"elastic": ElasticOptions}
 
     @classmethod

@@ -714,7 +714,7 @@ class LineContactSolver(FirstBodySolver):
     #: the backend it is the line-contact path of (for messages)
     name = "elastic"
     capabilities = Capabilities(partial_slip=True, subsurface=True, debris=False,
-                                contacts=("line",))
+                                contacts=("line",), repeatable=True)
     contact = "line"
 
     def __init__(

@@ -664,6 +664,7 @@ def build_loop(cfg: FrettingConfig, case: FrettingCase | None = None) -> Frettin
         return FrettingLoop(solver, crit, amplitude=c.amplitude, n_increments=c.n_increments,
                             strategy=strategy, debris=debris,
                             debris_every=cfg.debris.every or 1,
-                            geometry_tolerance=cfg.jump.geometry_tolerance or None)
+                            geometry_tolerance=cfg.jump.geometry_tolerance or None,
+                            update_tolerance=cfg.wear.update_tolerance or None)
     except ValueError as err:  # CriterionUnavailable included
         raise ConfigError(f"wear: {err}") from None

@@ -25,7 +25,7 @@ from tribodem.contact.fe.options import FEOptions
 from tribodem.contact.geometry import CrossedCylinders, CylinderOnFlat, FlatPunch, SphereOnFlat
 from tribodem.contact.options import STRENGTH_RANGE, ElasticOptions, PlasticOptions
 from tribodem.fretting.criteria import ALPHA_SEED, ARCHARD_K, UTS_EN24T, YIELD_EN24T
-from tribodem.fretting.loop import GEOMETRY_TOLERANCE
+from tribodem.fretting.loop import GEOMETRY_TOLERANCE, UPDATE_TOLERANCE
 from tribodem.io.config import ConfigError, format_validation_error, merge
 from tribodem.io.model import PhysicalConfig, StrictModel, physical
 from tribodem.io.record import (
@@ -234,6 +234,11 @@ class WearConfig(StrictModel):
         "the exponent ~0, eps_f = 1.65 eps0)")
     swt_nz: int = Field(17, ge=2, le=129, description="swt: subsurface levels")
     swt_plane_step: float = Field(5.0, gt=0, le=90, description="swt: candidate planes, deg")
+    update_tolerance: float = Field(
+        UPDATE_TOLERANCE, ge=0, description="largest depth increment of one geometry update "
+        "/ the contact's elastic approach: a cycle that wears more is solved again in "
+        "sub-cycles, each adding its share of the cycle's wear (archard, energy on the "
+        "elastic backend; 0: one update a cycle)")
 
 
 class JumpConfig(StrictModel):
@@ -299,7 +304,9 @@ class OutputConfig(StrictModel):
 #: control on a fitted curve (:class:`~tribodem.cyclejump.SmoothJump`); the polynomial
 #: strategy that had the name is "polynomial"; ``[elastic] line_model`` (default
 #: "plane-strain": a line contact on one cross-section; the n x n periodic window before).
-CONFIG_VERSION = 5
+#: 6: ``[wear] update_tolerance`` (default 0.05: a cycle that wears more than that share of
+#: the elastic approach is split into sub-cycles; one geometry update a cycle before).
+CONFIG_VERSION = 6
 
 
 #: ``--quick``: a 64^2 window, 10 cycles, a coarser subsurface grid and a shorter debris
@@ -474,12 +481,18 @@ def recorded_config(data: Mapping[str, Any]) -> dict[str, Any]:
     version 5 ``[jump] strategy = "adaptive"`` was the polynomial strategy of the thesis'
     section 4.3 (:class:`~tribodem.cyclejump.AdaptiveJump`): it becomes "polynomial"; and
     the elastic backend solved a line contact on the n x n periodic window: ``[elastic]
-    line_model`` is set to "periodic-2d" in the records of line-contact runs.
+    line_model`` is set to "periodic-2d" in the records of line-contact runs. Before
+    version 6 the geometry was updated once a cycle: ``[wear] update_tolerance`` is set to
+    0 where the record leaves it out.
     """
     data = dict(data)
     version = data.get("config_version", 1)
-    if version == CONFIG_VERSION or version not in (1, 2, 3, 4):
+    if version == CONFIG_VERSION or version not in (1, 2, 3, 4, 5):
         return data
+    wear = dict(data["wear"]) if isinstance(data.get("wear"), dict) else {}
+    data["wear"] = {"update_tolerance": 0.0, **wear}
+    if version == 5:
+        return {**data, "config_version": CONFIG_VERSION}
     jump = data.get("jump")
     if isinstance(jump, dict) and jump.get("strategy") == "adaptive":
         data["jump"] = {**jump, "strategy": "polynomial"}

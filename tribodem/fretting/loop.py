@@ -7,6 +7,17 @@ cumulative wear maps and to the recessions the solver sees (geometry update: the
 recedes by the worn depth, the half-space analogue of eqs 3.7-3.8), integrate the worn
 volume exactly on the grids (sum of depth x cell area) and record the cycle.
 
+Sub-cycles: the geometry is updated once a cycle, an explicit step of the wear equation in
+the cycle count. A cycle whose wear changes the depth anywhere by more than
+``update_tolerance`` x the contact's elastic approach is a step too long for it: on a grid
+fine enough to resolve the scar's edge, the edge points take the load the worn points
+shed and overshoot into pits one cell wide. Such a cycle is solved again in ``m`` passes
+on the surfaces as they wear (m = ceil(increment / (tolerance x approach))), each pass
+adding 1/m of its cycle's wear: the same total k P s, with the geometry following it. Only
+for rate criteria (Archard, energy: the wear of a pass is linear in its duration) on
+backends whose cycles can be repeated (``Capabilities.repeatable``) and without debris;
+elsewhere a cycle over the tolerance is counted and stated in the summary.
+
 Cycle-jumping (:mod:`tribodem.cyclejump`): the state is the pair of cumulative wear-depth
 maps (flattened into one array). After each simulated cycle the strategy may skip ``n``
 cycles; the maps are extrapolated element by element and ``n`` rows with ``jumped = 1``
@@ -29,7 +40,7 @@ from tribodem.contact.base import FirstBodySolver, WindowTooSmallError, cycle_of
 from tribodem.contact.fe.ccx import FESolverStopped
 from tribodem.contact.geometry import HeightMap, Recession
 from tribodem.cyclejump import JumpStrategy
-from tribodem.fretting.criteria import Criterion, CriterionUnavailable, TrackGrid
+from tribodem.fretting.criteria import Criterion, CriterionUnavailable, RateCriterion, TrackGrid
 from tribodem.fretting.debris import DebrisField, DEPhaseResult, debris_target, run_de_phase
 
 #: Columns of ``results.csv`` (one row per simulated or jumped cycle).
@@ -162,8 +173,19 @@ def _scar_mean(w: NDArray[np.float64]) -> float:
 
 #: Default of ``FrettingLoop(geometry_tolerance=...)`` (docs/fretting.md, "Jumping").
 GEOMETRY_TOLERANCE = 0.05
+#: Default of ``FrettingLoop(update_tolerance=...)``: the largest depth increment of one
+#: geometry update (a cycle, or a sub-cycle) over the contact's elastic approach.
+UPDATE_TOLERANCE = 0.05
+#: Most sub-cycles a cycle is split into (beyond it the summary says the tolerance was missed)
+MAX_SUBCYCLES = 64
 #: ``_geometry_limit`` without a limit (no tolerance, or nothing worn)
 NO_LIMIT = 1 << 62
+
+
+def _no_updates() -> dict[str, Any]:
+    """``FrettingLoop.wear_updates`` before any cycle."""
+    return {"cycles_split": 0, "most_subcycles": 1, "cycles_over_tolerance": 0,
+            "largest_increment_over_approach": 0.0}
 
 
 def _no_decisions() -> dict[str, Any]:
@@ -193,6 +215,7 @@ class FrettingLoop:
         debris: DebrisField | None = None,
         debris_every: int = 1,
         geometry_tolerance: float | None = GEOMETRY_TOLERANCE,
+        update_tolerance: float | None = UPDATE_TOLERANCE,
     ) -> None:
         criterion.check_solver(solver)
         if debris is not None:
@@ -230,6 +253,10 @@ class FrettingLoop:
         #: jumps keep the geometry the next cycle sees: the jumped depth increment stays
         #: below this fraction of the contact's elastic approach (None: strategy alone)
         self.geometry_tolerance: float | None = geometry_tolerance
+        #: a cycle's largest depth increment over the elastic approach above which the
+        #: cycle is split into sub-cycles (None: one update a cycle, whatever it wears)
+        self.update_tolerance: float | None = update_tolerance or None
+        self._updates = _no_updates()
         self._last_du = np.zeros(self.grid.upper_shape)
         self._last_dl = np.zeros(self.grid.lower_shape)
         #: every jump decision so far (``jump_decisions``), for the summary
@@ -298,6 +325,39 @@ class FrettingLoop:
             extra["de_phase"] = 0
             if self._cycle % self.debris_every == 0 and self.debris.n > 0:
                 extra |= self._de_phase()
+        du, dl, per = self._solve_pass()
+        m = self._subcycles(du, dl, per["contact_area_m2"])
+        if m > 1:  # the cycle again in m passes, each adding 1/m of its wear
+            du, dl = du / m, dl / m
+            self.wear_upper = self.wear_upper + du
+            self.wear_lower = self.wear_lower + dl
+            passes = [per]
+            for _ in range(m - 1):
+                self._apply_geometry()
+                du_k, dl_k, per_k = self._solve_pass()
+                du, dl = du + du_k / m, dl + dl_k / m
+                self.wear_upper = self.wear_upper + du_k / m
+                self.wear_lower = self.wear_lower + dl_k / m
+                passes.append(per_k)
+            per = {k: (max(p[k] for p in passes) if k.startswith("max_")
+                       else sum(p[k] for p in passes) / m) for k in per}
+        else:
+            self.wear_upper = self.wear_upper + du
+            self.wear_lower = self.wear_lower + dl
+        self._last_du, self._last_dl = du, dl
+        self._generate_debris(du, dl)
+        if self.debris is not None:
+            extra |= {"debris_particles": self.debris.n,
+                      "debris_load_fraction": float(self.solver.debris_load) / self.solver.load,
+                      "max_pressure_with_debris_Pa": self._pmax_debris,
+                      "load_balance_error": self._balance}
+        return {**per, **extra,
+                "criterion": self.criterion.info()}  # this cycle's diagnostics (criterion.csv)
+
+    def _solve_pass(self) -> tuple[NDArray[np.float64], NDArray[np.float64], dict[str, float]]:
+        """One pass of the stroke on the current surfaces: (the wear depth it gives the
+        upper and the lower body, m; its dissipated energy J, largest pressure and traction
+        Pa, mean contact area m^2)."""
         self.solver.begin_cycle()  # the solver's hook (elastic-plastic: EPIC at full load)
         crit = self.criterion
         crit.begin_cycle(self.grid, self.solver)
@@ -318,26 +378,41 @@ class FrettingLoop:
                 balance = max(balance, abs(float(total.sum()) * cell - load) / load)
                 if s == 0.0:
                     self._p_load = total
+        self._pmax_debris, self._balance = pmax_d, balance
         du, dl = crit.depths()
         if np.any(du < 0) or np.any(dl < 0):
             raise RuntimeError(f"criterion '{crit.name}' returned a negative wear depth")
-        self.wear_upper = self.wear_upper + du
-        self.wear_lower = self.wear_lower + dl
-        self._last_du, self._last_dl = du, dl
-        self._generate_debris(du, dl)
-        if self.debris is not None:
-            extra |= {"debris_particles": self.debris.n,
-                      "debris_load_fraction": float(self.solver.debris_load) / load,
-                      "max_pressure_with_debris_Pa": pmax_d,
-                      "load_balance_error": balance}
-        return {
-            "dissipated_energy_J": energy,
-            "max_pressure_Pa": pmax,
-            "max_traction_Pa": qmax,
-            "contact_area_m2": area / len(self.offsets),
-            **extra,
-            "criterion": crit.info(),  # this cycle's diagnostics (criterion.csv)
-        }
+        return du, dl, {"dissipated_energy_J": energy, "max_pressure_Pa": pmax,
+                        "max_traction_Pa": qmax, "contact_area_m2": area / len(self.offsets)}
+
+    def _subcycles(self, du: NDArray[np.float64], dl: NDArray[np.float64],
+                   area: float) -> int:
+        """Passes the cycle's wear (``du``, ``dl``, m; mean contact area ``area``, m^2) is
+        split into: ceil(increment / (update_tolerance x approach)) up to
+        :data:`MAX_SUBCYCLES` where the loop can repeat the cycle (module docstring), else
+        1; every cycle over the tolerance is counted for the summary."""
+        tol = self.update_tolerance
+        ratio = max(float(du.max(initial=0.0)), float(dl.max(initial=0.0))) / self._approach(area)
+        u = self._updates
+        u["largest_increment_over_approach"] = max(u["largest_increment_over_approach"], ratio)
+        if tol is None or ratio <= tol:
+            return 1
+        if not (isinstance(self.criterion, RateCriterion) and self.debris is None
+                and self.solver.capabilities.repeatable):
+            u["cycles_over_tolerance"] += 1
+            return 1
+        m = min(math.ceil(ratio / tol), MAX_SUBCYCLES)
+        u["cycles_split"] += 1
+        u["most_subcycles"] = max(u["most_subcycles"], m)
+        u["cycles_over_tolerance"] += int(ratio / m > tol)
+        return m
+
+    def wear_updates(self) -> dict[str, Any]:
+        """The run's geometry updates against ``update_tolerance``: the cycles split into
+        sub-cycles, the most sub-cycles of one cycle, the cycles whose update stayed over
+        the tolerance (not splittable, or beyond :data:`MAX_SUBCYCLES`) and the largest
+        depth increment of one simulated cycle over the elastic approach."""
+        return {"update_tolerance": self.update_tolerance, **self._updates}
 
     def _row(self, cycle: int, jumped: bool, per_cycle: dict[str, float]) -> dict[str, Any]:
         cell = self.grid.cell_area
@@ -426,12 +501,16 @@ class FrettingLoop:
         half-space) takes b^2 / R = 4 P' / (pi E*), P' the load per unit length of the
         periodic window."""
         inc = max(float(self._last_du.max(initial=0.0)), float(self._last_dl.max(initial=0.0)))
+        return inc, self._approach(float(per.get("contact_area_m2", 0.0)))
+
+    def _approach(self, area: float) -> float:
+        """The contact's elastic approach (m) for a mean contact area ``area`` (m^2):
+        ``_geometry_scale``."""
         sol = self.solver
         if sol.contact == "line":  # b^2 / R = 4 P' / (pi E*), P' the load per unit length
-            return inc, 4.0 * sol.load / (math.pi * sol.modulus * sol.window)
-        a = math.sqrt(max(float(per.get("contact_area_m2", 0.0)), self.grid.cell_area)
-                      / math.pi)
-        return inc, 3.0 * sol.load / (4.0 * a * sol.modulus)
+            return 4.0 * sol.load / (math.pi * sol.modulus * sol.window)
+        a = math.sqrt(max(area, self.grid.cell_area) / math.pi)
+        return 3.0 * sol.load / (4.0 * a * sol.modulus)
 
     def _geometry_limit(self, inc: float, approach: float) -> int:
         """Longest jump the geometry allows (``NO_LIMIT``: none): the jumped depth
@@ -510,6 +589,7 @@ class FrettingLoop:
             "cycles_simulated": hist.cycles_simulated,
             "cycles_jumped": hist.cycles_jumped,
             "jump_decisions": dict(self._decisions),
+            "wear_updates": dict(self._updates),
         }
 
     def load_state_dict(self, state: dict[str, Any]) -> None:
@@ -552,6 +632,7 @@ class FrettingLoop:
         hist.cycles_jumped = int(state["cycles_jumped"])
         # checkpoints written before the decisions were counted have none
         self._decisions = dict(state.get("jump_decisions") or _no_decisions())
+        self._updates = dict(state.get("wear_updates") or _no_updates())
         hist.wall_time_s = self._wall
         hist.de_phases = self.de_phases
         self.history = hist

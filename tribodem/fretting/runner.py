@@ -223,6 +223,7 @@ def write_outputs(case: FrettingCase, loop: FrettingLoop, hist: FrettingHistory,
         "jump": {"strategy": cfg.jump.strategy,
                  **({"params": loop.strategy.params(), **jump_reading(loop)}
                     if loop.strategy else {})},
+        "wear_updates": update_reading(loop),
         "window_m": loop.solver.window,
         "contact_case": case.summary(loop.solver),
         "first_body_report": loop.solver.report(),
@@ -250,6 +251,29 @@ def stop_error(loop: FrettingLoop, hist: FrettingHistory, out: Path) -> runs.Run
     runs.announce(out, ck, resume_hint=hint)
     return runs.RunStopped(f"{hist.stopped} (results.csv, summary.json and figures up "
                            f"to cycle {loop.cycles_done} are written)")
+
+
+def update_reading(loop: FrettingLoop) -> dict[str, Any]:
+    """The run's geometry updates (``FrettingLoop.wear_updates``) and one sentence on them,
+    for summary.json's ``wear_updates``."""
+    u = loop.wear_updates()
+    tol, ratio = u["update_tolerance"], u["largest_increment_over_approach"]
+    if tol is None:
+        text = (f"one geometry update a cycle (wear.update_tolerance = 0); the largest "
+                f"depth increment of a cycle was {ratio:.3g} elastic approaches")
+    else:
+        text = (f"a cycle's wear changes the depth anywhere by at most {tol:g} elastic "
+                f"approaches per update (wear.update_tolerance); the largest cycle's was "
+                f"{ratio:.3g}")
+        if u["cycles_split"]:
+            text += (f": {u['cycles_split']} cycles were split into sub-cycles (at most "
+                     f"{u['most_subcycles']}), each adding its share of the cycle's wear")
+        if u["cycles_over_tolerance"]:
+            text += (f"; {u['cycles_over_tolerance']} cycles stayed over it (this criterion, "
+                     "backend or the debris cannot repeat a cycle, or the split reached its "
+                     "limit): their scars depend on the wear per cycle; a smaller wear "
+                     "coefficient per cycle (or a coarser grid) resolves them")
+    return {**u, "reading": text}
 
 
 def jump_reading(loop: FrettingLoop) -> dict[str, Any]:
