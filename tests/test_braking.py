@@ -689,6 +689,41 @@ def test_quick_preset_overrides_the_config_file(tmp_path: Path) -> None:
     assert resolve_config(c, quick=True, condition=4) == q
 
 
+
+def test_default_cell_is_the_trend_study_cell_and_quick_one_junction() -> None:
+    """The default cell is 16 one-junction cells wide with the one-junction cell's
+    wavelengths (modes 16..64 of 3,456 um = 216..54 um), ~12,500 disks by the packing's
+    area fraction; ``--quick`` is one junction (144 um, modes 1..3). roughness_first_mode
+    0 (auto) is ceil(modes / 4) (the band of modes 1..4 scaled), resolved in the model so
+    a recorded config holds the number; an explicit first mode is kept."""
+    from tribodem.braking.config import (
+        JUNCTION_WIDTH_M,
+        WIDE_FACTOR,
+        BrakingConfig,
+        cell_particles,
+        resolve_config,
+    )
+
+    d = resolve_config()
+    assert d.geometry.width_m == WIDE_FACTOR * JUNCTION_WIDTH_M == pytest.approx(3456e-6)
+    assert (d.geometry.roughness_first_mode, d.geometry.roughness_modes) == (16, 64)
+    # the longest and shortest wavelengths: the one-junction cell's 216 and 54 um
+    assert d.geometry.width_m / 16 == pytest.approx(JUNCTION_WIDTH_M)
+    assert d.geometry.width_m / 64 == pytest.approx(JUNCTION_WIDTH_M / 4)
+    assert 11_000 < cell_particles(d) < 14_000
+    q = resolve_config(quick=True)
+    assert q.geometry.width_m == 144e-6 and q.geometry.roughness_first_mode == 1
+    assert cell_particles(q) < cell_particles(d) / 20
+    q16 = resolve_config({"geometry": {"roughness_first_mode": 16}}, quick=True)
+    assert q16.geometry.roughness_first_mode == 1  # the preset's auto, not the file's 16
+    for modes, first in ((2, 1), (4, 1), (6, 2), (64, 16)):
+        g = resolve_config({"geometry": {"roughness_modes": modes}}).geometry
+        assert g.roughness_first_mode == first, modes
+    assert resolve_config({"geometry": {"roughness_first_mode": 1}}).geometry \
+        .roughness_first_mode == 1
+    assert BrakingConfig.model_validate(d.model_dump()) == d
+
+
 def test_steady_state_rule() -> None:
     from tribodem.braking.steady import STEADY_CUTS, steady_state
 

@@ -255,3 +255,56 @@ def test_sweep_options_refused_before_any_work(config: Path, tmp_path: Path) -> 
     assert not out.exists()
     r = run_tribodem("braking", "sweep", "--help", timeout=120)
     assert "--packings" in r.stdout and "--seeds" not in r.stdout
+
+
+def test_projected_wall_time_is_rounds_of_one_member() -> None:
+    """``projected_wall_s``: equal members fill ceil(N / W) rounds (closed form), one
+    worker runs them one after the other, more workers than members is one round;
+    nonsense counts are refused."""
+    from tribodem.braking import projected_wall_s
+
+    assert projected_wall_s(40, 900.0, 1) == 40 * 900.0
+    assert projected_wall_s(40, 900.0, 16, startup_s=60.0) == 60.0 + 3 * 900.0
+    assert projected_wall_s(40, 900.0, 40) == projected_wall_s(40, 900.0, 400) == 900.0
+    for w in range(1, 50):  # never below the total work shared out, never a round more
+        t = projected_wall_s(40, 1.0, w)
+        assert 40 / w <= t < 40 / w + 1
+    with pytest.raises(ValueError, match="workers = 0"):
+        projected_wall_s(40, 900.0, 0)
+    with pytest.raises(ValueError, match="member_s = -1"):
+        projected_wall_s(40, -1.0, 2)
+
+
+def test_batch_cluster_example_writes_one_core_jobs_and_projects(tmp_path: Path) -> None:
+    """examples/braking_cluster.py (dask-jobqueue, SLURM): the job script it would submit
+    asks for one core and one one-thread worker with the thread counts pinned to 1; the
+    member cost is the mean wall time of the finished members of a sweep folder (a
+    stopped one is not counted); the projection is ``projected_wall_s`` per size."""
+    pytest.importorskip("dask_jobqueue")
+    import argparse
+    import importlib.util
+
+    path = Path(__file__).resolve().parents[1] / "examples" / "braking_cluster.py"
+    spec = importlib.util.spec_from_file_location("braking_cluster", path)
+    assert spec is not None and spec.loader is not None
+    ex = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(ex)
+    for k, (status, wall) in enumerate((("finished", 100.0), ("finished", 300.0),
+                                        ("stopped", 5.0))):
+        d = tmp_path / f"condition_{k + 1}" / "seed_0"
+        d.mkdir(parents=True)
+        (d / "summary.json").write_text(json.dumps({"status": status, "wall_time_s": wall}))
+    assert ex.measured_member_s(tmp_path) == (200.0, 2)
+    with pytest.raises(ValueError, match="no finished member"):
+        ex.measured_member_s(tmp_path / "condition_3")
+    rows = ex.projection(40, 200.0, (1, 16, 40), startup_s=60.0)
+    assert rows == [(1, 60.0 + 8000.0), (16, 60.0 + 600.0), (40, 260.0)]
+    a = argparse.Namespace(memory="2GB", walltime="04:00:00", queue="long")
+    cluster = ex.make_cluster(a)
+    try:
+        script = cluster.job_script()
+    finally:
+        cluster.close()
+    assert "#SBATCH --cpus-per-task=1" in script and "--partition=long" in script
+    assert "--nthreads 1" in script and "OMP_NUM_THREADS=1" in script
+    assert "NUMBA_NUM_THREADS=1" in script and "-t 04:00:00" in script

@@ -9,10 +9,12 @@ import pytest
 from tribodem.dem import Box, Material, ParticleState, Simulation
 from tribodem.dem.bonds import (
     ParallelBonds,
+    bond_consts_2d,
     bond_consts_3d,
     bond_csr,
     bond_forces,
     bond_forces_2d,
+    bond_forces_2d_lanes,
     bond_forces_3d,
     bond_screen,
     gather_bonds,
@@ -417,6 +419,59 @@ def test_2d_screen_gives_the_same_bits() -> None:
     assert 0 < n1 == n2 < nb
     for x, y in zip(a1, a2, strict=True):
         assert np.array_equal(x, y)
+
+
+
+def test_2d_batch_kernel_matches_the_scalar_one() -> None:
+    """Disks: ``bond_forces_2d_lanes`` (batches, SIMD lanes) gives ``bond_forces_2d``'s
+    bits (with its screen) on serial summed and threaded stored passes, over several steps
+    with breaks in both modes, bonds broken before, a periodic axis, turned and nearly
+    reversed normals, a partial last batch (nb not a multiple of the batch width) and
+    varied bond sizes; signs of zeros included."""
+    rng = np.random.default_rng(21)
+    n, nb = 2000, 4501
+    pos, vel, omega, radius, i, j, nrm = _disk_bonds(rng, n, nb, 0.1)
+    nrm[:, :2] += rng.normal(0, 1e-3, (nb, 2))
+    nrm[::301, :2] *= -1.0  # c ~ -1: the rotation's other branch
+    nrm /= np.linalg.norm(nrm, axis=1)[:, None]
+    one = np.ones(nb)
+    rb, area, ib = R * rng.uniform(0.5, 1.0, nb), 1e-6 * one, 1e-13 * rng.uniform(1, 2, nb)
+    kn, ks, tens, coh, tanphi = 5e11 * one, 3e11 * one, 2e3 * one, 3e3 * one, 0.1 * one
+    screen = bond_screen(area, rb, ib)
+    kc = bond_consts_2d(rb, area, ib, kn, ks, tens, coh, tanphi)
+    length, periodic = np.array([0.1, 0.0, 0.0]), np.array([True, False, False])
+    gstart, gbond = bond_csr(i, j, n, by_bond=True)
+    mode0 = np.zeros(nb, np.int8)
+    mode0[::97] = 2
+    fs0 = np.c_[rng.normal(0, 1e-3, (nb, 2)), np.zeros(nb)]
+    mb0 = np.c_[np.zeros((nb, 2)), rng.normal(0, 1e-9, nb)]
+    for summed in (True, False):
+        outs = []
+        for lanes in (False, True):
+            arrays = [np.zeros(nb), fs0.copy(), mb0.copy(), nrm.copy(), mode0.copy(),
+                      np.zeros(nb, np.int8), np.zeros((nb, 9)), np.zeros((nb, 3)),
+                      np.zeros((nb, 3)), np.zeros((nb, 3))]
+            ext = [np.full((n, 3), 0.25), np.full((n, 3), -0.5)]
+            nnew = 0
+            for _ in range(3):
+                if lanes:
+                    k = bond_forces_2d_lanes.serial if summed else bond_forces_2d_lanes.parallel
+                    nnew += k(pos, vel, omega, radius, i, j, rb, area, ib, tens, coh, tanphi,
+                              *arrays, 1e-4, length, periodic, summed, *ext, kc)
+                else:
+                    k = bond_forces_2d.serial if summed else bond_forces_2d.parallel
+                    nnew += k(pos, vel, omega, radius, i, j, rb, area, ib, kn, ks, tens, coh,
+                              tanphi, *arrays, 1e-4, length, periodic, summed, *ext, screen)
+                if not summed:
+                    gather_bonds.parallel(gstart, gbond, i, arrays[4], *arrays[7:], *ext)
+            outs.append((nnew, arrays, ext))
+        (n1, a1, e1), (n2, a2, e2) = outs
+        modes = a1[4]
+        assert 0 < n1 == n2 < nb
+        assert np.any((modes == 1) & (mode0 == 0)) and np.any((modes == 2) & (mode0 == 0))
+        for x, y in zip(a1 + e1, a2 + e2, strict=True):
+            assert np.array_equal(x, y)
+            assert np.array_equal(np.signbit(x), np.signbit(y))
 
 
 def test_bad_input_is_refused() -> None:

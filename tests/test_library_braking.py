@@ -61,6 +61,31 @@ def test_run_from_python_returns_its_summary_and_table(lib_run: RunResult) -> No
     assert isinstance(tribodem.braking.resolve_config(CONFIG), BrakingConfig)
 
 
+def test_summary_states_what_stands_for_the_backing_plate(lib_run: RunResult) -> None:
+    """The summary states the backing: the dashpots' impedances are the pad's rho c_p and
+    rho c_s (plane strain, table 1 E, nu, rho: closed form), the plate's mass per area is
+    the plate mass over W t, and the real back plate's travel under the full pressure over
+    the run is p T^2 / (2 m) with the assumed 126 kg/m^2."""
+    import math
+
+    from tribodem.braking.model import PLATE_AREAL_MASS, materials
+
+    s = lib_run.summary
+    pad = materials("calibrated")[1]
+    e, nu, rho = pad.young, pad.poisson, pad.density
+    c_p = math.sqrt(e * (1 - nu) / (rho * (1 + nu) * (1 - 2 * nu)))
+    c_s = math.sqrt(e / (2 * rho * (1 + nu)))
+    assert s["backing"] == "absorbing"
+    assert s["backing_impedance_normal_Pa_s_m"] == pytest.approx(rho * c_p, rel=1e-12)
+    assert s["backing_impedance_shear_Pa_s_m"] == pytest.approx(rho * c_s, rel=1e-12)
+    assert s["backing_plate_areal_mass_kg_m2"] == pytest.approx(
+        s["plate_mass_kg"] / (s["cell_width_m"] * 1.0), rel=1e-12)
+    assert s["backing_real_plate_areal_mass_kg_m2"] == PLATE_AREAL_MASS == 126.0
+    assert s["backing_real_plate_travel_m"] == pytest.approx(
+        s["pressure_Pa"] * s["simulated_time_s"] ** 2 / (2 * PLATE_AREAL_MASS), rel=1e-9)
+    assert any("back plate" in a for a in s["assumptions"])
+
+
 def test_interrupted_run_resumed_from_python_equals_the_command_line(
         lib_run: RunResult, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """The command line on the same config gives the library's run bitwise; a library

@@ -6,7 +6,8 @@ As a library: :func:`run` (one run, what ``tribodem braking run`` does) and :fun
 (conditions x packings on Dask, what ``tribodem braking sweep`` does), each returning a
 :class:`~tribodem.io.record.RunResult` (``.summary``, ``.to_dataframe()``); the config as
 a :class:`BrakingConfig`, a dict shaped like the TOML file or a TOML file's path. Lower
-down: :func:`run_braking` on a :class:`RunSetup`, and :class:`BrakingLoop`.
+down: :func:`run_braking` on a :class:`RunSetup`, and :class:`BrakingLoop`;
+:func:`projected_wall_s` projects a sweep's wall time on a cluster of a given size.
 """
 
 from tribodem.braking.api import run, sweep
@@ -20,6 +21,7 @@ from tribodem.braking.conditions import (
     speed_to_rpm,
 )
 from tribodem.braking.config import BrakingConfig, resolve_config, setup_from_config
+from tribodem.braking.ensemble import projected_wall_s
 from tribodem.braking.loop import BrakingLoop
 from tribodem.braking.model import Geometry, Interface, build_interface, start_sliding
 from tribodem.braking.setup import RunSetup
@@ -36,6 +38,7 @@ __all__ = [
     "build_interface",
     "get_condition",
     "load_to_pressure",
+    "projected_wall_s",
     "pressure_to_load",
     "resolve_config",
     "rpm_to_speed",

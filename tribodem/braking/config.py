@@ -54,12 +54,27 @@ class ConditionCfg(StrictModel):
         return self
 
 
-class GeometryCfg(StrictModel):
-    """Interface cell sizes (m)."""
+#: the one-junction cell's width (m): ``--quick`` is narrower still, and
+#: ``examples/braking_one_junction.toml`` is this cell (the default before the trend-study
+#: cell); the default cell is ``WIDE_FACTOR`` times as wide with the same asperities
+JUNCTION_WIDTH_M = 216e-6
+#: the default (trend-study) cell is this many one-junction cells wide: in contact 90-97 %
+#: of the sliding time where the one-junction cell is in contact 12-56 % (docs/braking.md
+#: "Wider cells and more packings")
+WIDE_FACTOR = 16
+#: sine modes of the one-junction cell (wavelengths W/1 .. W/4)
+JUNCTION_MODES = 4
 
-    width_m: float = Field(216e-6, gt=0, **physical(
+
+class GeometryCfg(StrictModel):
+    """Interface cell sizes (m). The default is the trend-study cell: 16 one-junction cells
+    wide (3,456 um, ~12,600 disks), the one-junction cell's wavelengths (54-216 um) kept by
+    sine modes 16..64; ``--quick`` is a narrow cell (one junction, 144 um)."""
+
+    width_m: float = Field(WIDE_FACTOR * JUNCTION_WIDTH_M, gt=0, **physical(
         1e-6, 0.5, "m", "cell width along the sliding (periodic), m (the cell's particles "
-        "must fit in memory)"))
+        "must fit in memory); the default, 16 x 216 um, holds about 16 asperity junctions "
+        "and keeps the pad in contact >= 90 % of the sliding time"))
     disc_height_m: float = Field(72e-6, gt=0, **physical(
         1e-6, 0.1, "m", "disc (Q345B) height, m"))
     pad_height_m: float = Field(108e-6, gt=0, **physical(
@@ -67,14 +82,24 @@ class GeometryCfg(StrictModel):
     roughness_amplitude_m: float = Field(8e-6, ge=0, **physical(
         0.0, 1e-2, "m", "largest height of the random sine profiles cut into both surfaces, "
         "m"))
-    roughness_modes: int = Field(4, ge=1, le=64)
+    roughness_modes: int = Field(
+        WIDE_FACTOR * JUNCTION_MODES, ge=1, le=64,
+        description="highest sine mode k of the random profiles (wavelength width/k)")
     roughness_first_mode: int = Field(
-        1, ge=1, le=64, description="lowest sine mode k (wavelength width/k); in a cell n "
-        "times the default width, n keeps the default cell's wavelengths and asperities")
+        0, ge=0, le=64, description="lowest sine mode k (wavelength width/k); 0 = "
+        "ceil(roughness_modes / 4): wavelengths from width/modes to 4 width/modes, the "
+        "band of the one-junction cell (modes 1..4), so a cell n times as wide with n "
+        "times the modes has the same asperities")
     clearance_m: float = Field(5e-8, ge=0, **physical(
         0.0, 1e-2, "m", "gap between the pad's lowest and the disc's highest point at the "
         "start, m"))
     seed: int = Field(0, ge=0)
+
+    @model_validator(mode="after")
+    def _first_mode(self) -> GeometryCfg:
+        if self.roughness_first_mode == 0:  # resolved here: recorded configs hold the k
+            self.roughness_first_mode = max(1, math.ceil(self.roughness_modes / 4))
+        return self
 
 
 class RunCfg(StrictModel):
@@ -156,13 +181,16 @@ class BrakingConfig(PhysicalConfig):
     @classmethod
     def quick(cls) -> dict[str, Any]:
         """The ``--quick`` preset (a dict shaped like the TOML file, laid over the config):
-        a narrower cell (144 um) and a thinner disc (50 um) than the defaults, 20 us of
-        sliding. Its pad has the default height: a 50-um pad shattered under the first
+        a cell one asperity junction wide (144 um, 3 modes of wavelengths 48-144 um) instead
+        of the default 16 junctions, a thinner disc (50 um), 20 us of sliding: the pad is
+        then in contact only part of the time (docs/braking.md "Wider cells and more
+        packings"). Its pad has the default height: a 50-um pad shattered under the first
         impacts at conditions 1-4 (worn through within 0.06-0.55 mm, docs/braking.md
         "Bodies worn through")."""
         return {
             "geometry": {"width_m": 144e-6, "disc_height_m": 50e-6, "pad_height_m": 108e-6,
-                         "roughness_amplitude_m": 6e-6, "roughness_modes": 3},
+                         "roughness_amplitude_m": 6e-6, "roughness_modes": 3,
+                         "roughness_first_mode": 0},
             "run": {"duration_s": 20e-6, "distance_m": 0.0, "samples": 100,
                     "vtk_snapshots": 4},
         }

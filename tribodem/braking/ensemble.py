@@ -122,3 +122,21 @@ def plan_members(members: list[Member], out: Path, echo: Callable[[str], None]
                 echo(f"  {name}: starting over ({info})")
             todo.append(m)
     return results, todo
+
+
+def projected_wall_s(members: int, member_s: float, workers: int,
+                     startup_s: float = 0.0) -> float:
+    """Projected wall time (s) of a sweep of ``members`` members, each ``member_s``
+    seconds of one core (a measured member: ``wall_time_s`` of a finished member's
+    summary, one thread), on ``workers`` one-thread workers: every worker takes the next
+    member when it finishes one, so equal members run in ``ceil(members / workers)``
+    rounds: ``T = startup_s + ceil(N / W) member_s``. ``startup_s``: the cluster's start
+    (a batch queue's wait is not in it). A lower bound when members differ in cost (the
+    last round waits for its slowest); ``ValueError`` on a count below 1 or a negative
+    time."""
+    if members < 1 or workers < 1:
+        raise ValueError(f"members = {members!r}, workers = {workers!r}: both must be >= 1")
+    if not (member_s >= 0 and startup_s >= 0):
+        raise ValueError(f"member_s = {member_s!r}, startup_s = {startup_s!r}: must be >= 0 s")
+    rounds = -(-members // workers)
+    return startup_s + rounds * member_s

@@ -45,6 +45,7 @@ from numba import njit
 
 from tribodem.dem import Box, Material, ParallelBonds, ParticleState, PlaneWall, Simulation
 from tribodem.dem import compiled as dem_compiled
+from tribodem.dem.space import column_order
 from tribodem.dem.state import FIX_X, FIX_Y
 from tribodem.materials.library import CU_PM, Q345B, MaterialSpec
 from tribodem.materials.specimen import compact_by_radius_scaling
@@ -543,6 +544,10 @@ def build_interface(geometry: Geometry, pressure_Pa: float, micro: str = "calibr
     periodic = block == "periodic"
     pos, radii, stats = compact_periodic(disc, w, total, g.seed, g.compaction_stress, gap=gap,
                                          periodic_y=periodic)
+    # numbered column by column along the sliding (the packing itself unchanged): the
+    # step's passes then read nearby memory (BENCHMARKS.md, "Braking cell")
+    order = column_order(pos, 0.0, 2.0 * rmax)
+    pos, radii = pos[order], radii[order]
     blk = Block(pos.copy(), radii.copy(), w, total) if periodic else None
     if stats["loose_fraction"] > LOOSE_MAX:
         warnings.warn(f"interface packing (seed {g.seed}, width {w:.4g} m): "
@@ -580,6 +585,9 @@ def build_interface(geometry: Geometry, pressure_Pa: float, micro: str = "calibr
     box = Box([0.0, bottom - margin, 0.0], [w, top + margin, 0.0], [True, False, False])
     sim = Simulation(part, [disc.contact_material(), pad.contact_material()], box,
                      walls=[wall], dt_safety=dt_safety, local_damping=local_damping)
+    bi, bj = np.minimum(bi, bj), np.maximum(bi, bj)
+    bond_order = np.lexsort((bj, bi))  # bonds in particle order: nearby memory too
+    bi, bj = bi[bond_order], bj[bond_order]
     on_pad = group[bi] == PAD
     pick = lambda a, b: np.where(on_pad, b, a)  # noqa: E731
     bonds = ParallelBonds(sim, bi, bj, disc.bond_lambda,

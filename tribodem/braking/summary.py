@@ -25,7 +25,7 @@ from tribodem.braking.conditions import SEED_BRAKING_TIME_S, pressure_to_load, s
 from tribodem.braking.drive import CONTACT_EVERY
 from tribodem.braking.loop import BrakingLoop
 from tribodem.braking.measure import REMAINING
-from tribodem.braking.model import DISC, EJECTED, Interface
+from tribodem.braking.model import DISC, EJECTED, PLATE_AREAL_MASS, Interface
 from tribodem.braking.setup import RunSetup
 from tribodem.braking.steady import (
     STEADY_CUTS,
@@ -129,6 +129,29 @@ def _rate_fields(loop: BrakingLoop) -> dict[str, Any]:
     }
 
 
+def backing_fields(loop: BrakingLoop) -> dict[str, Any]:
+    """What stands for the pad's backing (the friction material and steel back plate the
+    cell omits): the plate's mass per area (kg/m^2) against the assumed real back plate's
+    (``PLATE_AREAL_MASS``), the distance ``p T^2 / (2 m)`` (m) that the real one would
+    travel under the full pressure p over the run's time T (the most it could follow the
+    wear), and, with the absorbing backing, the dashpots' impedances ``rho c_p`` and
+    ``rho c_s`` (Pa s/m: the omitted friction material's compliance to waves, which it
+    carries away without reflection)."""
+    setup, iface = loop.setup, loop.iface
+    area = iface.width * iface.disc.thickness
+    t_run = loop.sim.time - loop.t0
+    back = iface.backing
+    return {
+        "backing_plate_areal_mass_kg_m2": iface.stats["plate_mass_kg"] / area,
+        "backing_real_plate_areal_mass_kg_m2": PLATE_AREAL_MASS,
+        "backing_real_plate_travel_m": setup.pressure_Pa * t_run ** 2 / (2 * PLATE_AREAL_MASS),
+        "backing_impedance_normal_Pa_s_m": (
+            back.c_n * back.idx.size / area if back is not None else None),
+        "backing_impedance_shear_Pa_s_m": (
+            back.c_t * back.idx.size / area if back is not None else None),
+    }
+
+
 def _cell_fields(loop: BrakingLoop) -> dict[str, Any]:
     """The cell: particles and bonds, the plate (force N, pressure Pa, mass kg, travel
     m), the steps and time step (s), the geometry (m), the micro-parameters, the thermal
@@ -143,6 +166,7 @@ def _cell_fields(loop: BrakingLoop) -> dict[str, Any]:
         "plate_areal_mass_kg_m2": setup.plate_areal_mass,
         "plate_mass_kg": iface.stats["plate_mass_kg"],
         "plate_travel_m": loop.wall_y0 - float(iface.wall.point[1]),
+        **backing_fields(loop),
         "mean_wall_force_N": drive.mean,
         "mean_wall_pressure_Pa": drive.mean / (iface.width * iface.disc.thickness),
         "mean_wall_pressure_ratio": drive.mean / iface.target_force,
@@ -282,11 +306,17 @@ def _model_assumptions(setup: RunSetup) -> list[str]:
             "Cu-PM + 6 mm steel assumed, the seed gives no sizes)"
             if setup.plate_areal_mass else
             f"{setup.wall_mass_ratio} x the cell's pad mass") +
-        "; its mean force tends to the target by momentum balance",
+        "; its mean force tends to the target by momentum balance. It stands for the "
+        "pad's back plate: a light plate follows the cell's wear, which the real back "
+        "plate (backing_real_plate_areal_mass_kg_m2) could not within the run "
+        "(backing_real_plate_travel_m, against the wear depth): the run would become "
+        "displacement-controlled and open",
         "disc: anchored bottom layer fixed in y and driven at -v in x, the rest of the disc "
         "starts at -v; pad: top layer " + (
             "tied to the rest of the pad by non-reflecting (Lysmer) dashpots, rho c_p "
-            "relative to the plate in y and rho c_s in x (the support)"
+            "relative to the plate in y and rho c_s in x (the support): the omitted "
+            "friction material's compliance, as a medium that carries the impacts' waves "
+            "away (backing_impedance_normal_Pa_s_m, backing_impedance_shear_Pa_s_m)"
             if setup.backing == "absorbing" else "held in x (support wall), free face in y"),
         "rough surfaces: independent random profiles (sine modes of wavelengths W/k, k = "
         f"{setup.geometry.first_mode}..{setup.geometry.modes}, amplitudes ~ U(0.3, 1)/k, "

@@ -743,6 +743,226 @@ def bond_forces_2d(pos, vel, omega, radius, bi, bj, rb, area, ib, kn, ks, tens, 
     return nnew
 
 
+# ---------------------------------------------------------------- 2D bonds in batches
+# rows of a 2D batch's input buffer (``bond_forces_2d_lanes`` gathers them): separation
+# (min image), the two particles' in-plane velocities and spins about z, radii, then the
+# bond's stored normal, fn, fs and bending moment (z), then its constants from row P_K
+(P_D0, P_D1, P_VI0, P_VI1, P_VJ0, P_VJ1, P_WI, P_WJ, P_RI, P_RJ, P_O0, P_O1, P_FN, P_S0,
+ P_S1, P_MZ) = range(16)
+P_K = 16
+# columns of the per-bond constants of disks (``bond_consts_2d``)
+(K2_KNA, K2_KSA, K2_KNI, K2_INVA, K2_RBI, K2_TENS, K2_COH, K2_TANPHI) = range(8)
+N_K2 = 8
+N_P = P_K + N_K2
+# rows of its output buffer: the new normal and load, force on j, moments on i and j
+# (z), arm a_i, |Fs|, and the lane's verdict (0 intact for sure, 1 near a strength limit)
+(Q_N0, Q_N1, Q_FN, Q_S0, Q_S1, Q_MZ, Q_F0, Q_F1, Q_TI, Q_TJ, Q_AI, Q_FSM, Q_FLAG) = range(13)
+N_Q = 13
+
+
+def bond_consts_2d(rb: np.ndarray, area: np.ndarray, inertia: np.ndarray, kn: np.ndarray,
+                   ks: np.ndarray, tensile: np.ndarray, cohesion: np.ndarray,
+                   tan_phi: np.ndarray) -> np.ndarray:
+    """(nb, ``N_K2``): per-bond constants of ``bond_forces_2d_lanes`` (columns ``K2_*``):
+    kn A, ks A (N/m), kn I (N m) -- the products ``bond_forces_2d`` forms, the same
+    bits --, its screen's 1/A (1/m^2) and Rb/I (1/m^3) (``bond_screen``), sigma_t, c (Pa)
+    and tan phi: one row of 64 bytes per bond instead of eight streams."""
+    return np.ascontiguousarray(np.c_[kn * area, ks * area, kn * inertia, 1.0 / area,
+                                      rb / inertia, tensile, cohesion, tan_phi])
+
+
+@njit(cache=True, error_model="numpy")
+def _bond_lanes_2d(x, y, m, dt):  # pragma: no cover - numba
+    """The arithmetic of ``bond_forces_2d`` (with its screen) for the ``m`` bonds of one
+    batch, lane by lane without branches, so that LLVM runs it in SIMD registers: reads
+    the gathered rows ``x`` (``P_*``, the constants from ``P_K``; ``RS`` apart), writes
+    the rows ``y`` (``Q_*``). The same operations in the same order as
+    ``bond_forces_2d`` (the same bits); the branches there are selects here (both sides
+    computed, numpy's error model: a division by ``1 + c = 0`` makes a discarded inf).
+    Flag 1: the screen left a doubt, ``bond_forces_2d_lanes`` runs the exact test."""
+    for q in range(m):
+        d0 = x[P_D0 * RS + q]
+        d1 = x[P_D1 * RS + q]
+        dist = np.sqrt(d0 * d0 + d1 * d1)
+        inv = 1.0 / dist
+        n0 = d0 * inv
+        n1 = d1 * inv
+        o0 = x[P_O0 * RS + q]
+        o1 = x[P_O1 * RS + q]
+        c = o0 * n0 + o1 * n1
+        k2 = o0 * n1 - o1 * n0
+        s0 = x[P_S0 * RS + q]
+        s1 = x[P_S1 * RS + q]
+        mz = x[P_MZ * RS + q]
+        turn = c > -1.0
+        r0 = c * s0 - k2 * s1
+        r1 = c * s1 + k2 * s0
+        mzr = c * mz + k2 * mz / (1.0 + c) * k2
+        r0 = r0 if turn else s0
+        r1 = r1 if turn else s1
+        mz = mzr if turn else mz
+        rn = r0 * n0 + r1 * n1
+        s0 = r0 - rn * n0
+        s1 = r1 - rn * n1
+        ri = x[P_RI * RS + q]
+        ai = ri + 0.5 * (dist - ri - x[P_RJ * RS + q])
+        aj = dist - ai
+        wi2 = x[P_WI * RS + q]
+        wj2 = x[P_WJ * RS + q]
+        v0 = (x[P_VJ0 * RS + q] + aj * (wj2 * n1)) - (x[P_VI0 * RS + q] - ai * (wi2 * n1))
+        v1 = (x[P_VJ1 * RS + q] - aj * (wj2 * n0)) - (x[P_VI1 * RS + q] + ai * (wi2 * n0))
+        vn = v0 * n0 + v1 * n1
+        ksa = x[(P_K + K2_KSA) * RS + q]
+        fnb = x[P_FN * RS + q] - x[(P_K + K2_KNA) * RS + q] * vn * dt
+        s0 -= ksa * (v0 - vn * n0) * dt
+        s1 -= ksa * (v1 - vn * n1) * dt
+        mz -= x[(P_K + K2_KNI) * RS + q] * ((wj2 - wi2) * dt)
+        fsm = np.sqrt(s0 ** 2 + s1 ** 2)
+        inva = x[(P_K + K2_INVA) * RS + q]
+        tens = x[(P_K + K2_TENS) * RS + q]
+        coh = x[(P_K + K2_COH) * RS + q]
+        sn_a = -fnb * inva
+        bend_a = abs(mz) * x[(P_K + K2_RBI) * RS + q]
+        tau_a = fsm * inva
+        thr_a = sn_a * x[(P_K + K2_TANPHI) * RS + q]
+        safe = ((sn_a + bend_a < tens - 1e-9 * (abs(sn_a) + bend_a + tens))
+                & (tau_a < coh - thr_a - 1e-9 * (tau_a + coh + abs(thr_a))))
+        y[Q_FLAG * RS + q] = 0.0 if safe else 1.0
+        f0 = fnb * n0 + s0
+        f1 = fnb * n1 + s1
+        cz = n0 * f1 - n1 * f0
+        y[Q_N0 * RS + q] = n0
+        y[Q_N1 * RS + q] = n1
+        y[Q_FN * RS + q] = fnb
+        y[Q_S0 * RS + q] = s0
+        y[Q_S1 * RS + q] = s1
+        y[Q_MZ * RS + q] = mz
+        y[Q_F0 * RS + q] = f0
+        y[Q_F1 * RS + q] = f1
+        y[Q_TI * RS + q] = -ai * cz - mz
+        y[Q_TJ * RS + q] = -aj * cz + mz
+        y[Q_AI * RS + q] = ai
+        y[Q_FSM * RS + q] = fsm
+
+
+@kernel
+def bond_forces_2d_lanes(pos, vel, omega, radius, bi, bj, rb, area, ib, tens, coh, tanphi,
+                         fn, fs, mb, nrm, mode, newly, brk, fbond, tbi, tbj, dt, length,
+                         periodic, summed, ext_force, ext_torque, kc):
+    """``bond_forces_2d`` (with its screen) in batches of ``BW`` bonds: the same values
+    (bits). Arguments as there, the stiffnesses and screens in ``kc``
+    (``bond_consts_2d`` of the same bonds). Per batch: (1) gather the particles' and the
+    bonds' state into a buffer, (2) ``_bond_lanes_2d``: the arithmetic in SIMD lanes,
+    (3) per bond in increasing index, as ``bond_forces_2d``: skip broken bonds, the
+    exact strength test where the screen left a doubt (break, log and zero as there),
+    store the state and sum the bond into its particles (``summed``) or store it for
+    ``gather_bonds``. prange over tasks of ``B_TASK`` batches; each bond writes only its
+    own rows unless ``summed`` (serial build). Returns the number of breaks."""
+    nb = bi.shape[0]
+    nbat = (nb + BW - 1) // BW
+    ntask = (nbat + B_TASK - 1) // B_TASK
+    nnew = 0
+    for task in prange(ntask):
+        x = np.empty(N_P * RS)
+        y = np.empty(N_Q * RS)
+        for bat in range(task * B_TASK, min(nbat, (task + 1) * B_TASK)):
+            b0 = bat * BW
+            m = min(BW, nb - b0)
+            for q in range(m):
+                b = b0 + q
+                i = bi[b]
+                j = bj[b]
+                x[P_D0 * RS + q] = min_image(pos[j, 0] - pos[i, 0], length[0], periodic[0])
+                x[P_D1 * RS + q] = min_image(pos[j, 1] - pos[i, 1], length[1], periodic[1])
+                x[P_VI0 * RS + q] = vel[i, 0]
+                x[P_VI1 * RS + q] = vel[i, 1]
+                x[P_VJ0 * RS + q] = vel[j, 0]
+                x[P_VJ1 * RS + q] = vel[j, 1]
+                x[P_WI * RS + q] = omega[i, 2]
+                x[P_WJ * RS + q] = omega[j, 2]
+                x[P_RI * RS + q] = radius[i]
+                x[P_RJ * RS + q] = radius[j]
+                x[P_O0 * RS + q] = nrm[b, 0]
+                x[P_O1 * RS + q] = nrm[b, 1]
+                x[P_FN * RS + q] = fn[b]
+                x[P_S0 * RS + q] = fs[b, 0]
+                x[P_S1 * RS + q] = fs[b, 1]
+                x[P_MZ * RS + q] = mb[b, 2]
+                for k in range(N_K2):
+                    x[(P_K + k) * RS + q] = kc[b, k]
+            _bond_lanes_2d(x, y, m, dt)
+            for q in range(m):
+                b = b0 + q
+                if mode[b] != INTACT:
+                    continue
+                i = bi[b]
+                j = bj[b]
+                n0 = y[Q_N0 * RS + q]
+                n1 = y[Q_N1 * RS + q]
+                nrm[b, 0] = n0
+                nrm[b, 1] = n1
+                fnb = y[Q_FN * RS + q]
+                mz = y[Q_MZ * RS + q]
+                how = INTACT
+                if y[Q_FLAG * RS + q] != 0.0:  # bond_forces_2d's exact test
+                    fsm = y[Q_FSM * RS + q]
+                    mbm = np.sqrt(mz ** 2)
+                    sig_n = -fnb / area[b]
+                    sigma = sig_n + mbm * rb[b] / ib[b]
+                    tau = fsm / area[b]
+                    if sigma >= tens[b]:
+                        how = TENSILE
+                    elif tau >= coh[b] - sig_n * tanphi[b]:
+                        how = SHEAR
+                    if how != INTACT:
+                        ai = y[Q_AI * RS + q]
+                        mode[b] = how
+                        newly[b] = 1
+                        nnew += 1
+                        brk[b, B_X] = pos[i, 0] + ai * n0
+                        brk[b, B_Y] = pos[i, 1] + ai * n1
+                        brk[b, B_Z] = pos[i, 2]
+                        brk[b, B_FN] = fnb
+                        brk[b, B_FS] = fsm
+                        brk[b, B_MB] = mbm
+                        brk[b, B_MT] = 0.0
+                        brk[b, B_SIGMA] = sigma
+                        brk[b, B_TAU] = tau
+                        fn[b] = 0.0
+                        for k in range(3):
+                            fs[b, k] = 0.0
+                            mb[b, k] = 0.0
+                            if not summed:
+                                fbond[b, k] = 0.0
+                                tbi[b, k] = 0.0
+                                tbj[b, k] = 0.0
+                        continue
+                fn[b] = fnb
+                fs[b, 0] = y[Q_S0 * RS + q]
+                fs[b, 1] = y[Q_S1 * RS + q]
+                mb[b, 2] = mz
+                f0 = y[Q_F0 * RS + q]
+                f1 = y[Q_F1 * RS + q]
+                if summed:
+                    ext_force[i, 0] -= f0
+                    ext_force[i, 1] -= f1
+                    ext_torque[i, 2] += y[Q_TI * RS + q]
+                    ext_force[j, 0] += f0
+                    ext_force[j, 1] += f1
+                    ext_torque[j, 2] += y[Q_TJ * RS + q]
+                    continue
+                fbond[b, 0] = f0
+                fbond[b, 1] = f1
+                fbond[b, 2] = 0.0
+                tbj[b, 0] = 0.0
+                tbj[b, 1] = 0.0
+                tbj[b, 2] = y[Q_TJ * RS + q]
+                tbi[b, 0] = 0.0
+                tbi[b, 1] = 0.0
+                tbi[b, 2] = y[Q_TI * RS + q]
+    return nnew
+
+
 @kernel
 def gather_bonds(cstart, cbond, bi, mode, fbond, tbi, tbj, ext_force, ext_torque):
     """Add bond forces/moments to each particle (prange over particles, fixed order).
@@ -793,7 +1013,7 @@ class BondStep(NamedTuple):
     fbond: np.ndarray
     tbi: np.ndarray
     tbj: np.ndarray
-    screen: np.ndarray
+    kc: np.ndarray
 
 
 class BondStep3D(NamedTuple):
@@ -828,19 +1048,19 @@ class BondStep3D(NamedTuple):
 
 #: the compiled steps' event code: bonds broke this step (logged by ``after_compiled``)
 BONDS_BROKE = 1
-_bonds_2d = bond_forces_2d.serial
+_bonds_2d = bond_forces_2d_lanes.serial
 _bonds_3d = bond_forces_3d.serial
 
 
 @compiled.register(BondStep)
 @njit(cache=True)
 def _bond_step(s, c):  # pragma: no cover - numba
-    """``ParallelBonds.compute`` for disks on its serial build (bonds summed into
-    ``c.ext_force`` / ``c.ext_torque``); ``BONDS_BROKE`` when a bond broke."""
+    """``ParallelBonds.compute`` for disks on its serial build (``bond_forces_2d_lanes``,
+    summed into ``c.ext_force`` / ``c.ext_torque``); ``BONDS_BROKE`` when a bond broke."""
     nnew = _bonds_2d(c.pos, c.vel, c.omega, c.radius, s.i, s.j, s.rb, s.area, s.inertia,
-                     s.kn, s.ks, s.tensile, s.cohesion, s.tan_phi, s.fn, s.fs, s.mb,
-                     s.normal, s.mode, s.newly, s.brk, s.fbond, s.tbi, s.tbj, c.dt,
-                     c.length, c.periodic, True, c.ext_force, c.ext_torque, s.screen)
+                     s.tensile, s.cohesion, s.tan_phi, s.fn, s.fs, s.mb, s.normal, s.mode,
+                     s.newly, s.brk, s.fbond, s.tbi, s.tbj, c.dt, c.length, c.periodic, True,
+                     c.ext_force, c.ext_torque, s.kc)
     return BONDS_BROKE if nnew else 0
 
 
@@ -952,14 +1172,16 @@ class ParallelBonds:
         self.cstart, self.cbond = bond_csr(self.i, self.j, p.n)
         self.gstart, self.gbond = bond_csr(self.i, self.j, p.n, by_bond=True)
         self.screen = bond_screen(self.area, self.rb, self.inertia)
-        self.kc = self._consts_3d()
+        self.kc = self._consts()
 
-    def _consts_3d(self) -> np.ndarray:
-        """``bond_consts_3d`` of these bonds (spheres; empty for disks). Like ``screen``,
-        made at construction and by ``set_state``: after changing a bond's geometry,
-        stiffness or strength in place, call it again (``self.kc = ...``)."""
+    def _consts(self) -> np.ndarray:
+        """The per-bond constants of the batched kernels: ``bond_consts_2d`` (disks) or
+        ``bond_consts_3d`` (spheres) of these bonds. Like ``screen``, made at construction
+        and by ``set_state``: after changing a bond's geometry, stiffness or strength in
+        place, call it again (``self.kc = self._consts()``)."""
         if self.dim == 2:
-            return np.zeros((0, N_K))
+            return bond_consts_2d(self.rb, self.area, self.inertia, self.kn, self.ks,
+                                  self.tensile, self.cohesion, self.tan_phi)
         return bond_consts_3d(self.rb, self.area, self.inertia, self.polar, self.kn, self.ks,
                               self.tensile, self.cohesion, self.tan_phi)
 
@@ -984,12 +1206,12 @@ class ParallelBonds:
         summed = serial_run(nb, threads)
         length = sim.box_length
         if self.dim == 2:
-            nnew = bond_forces_2d.pick(nb, threads)(
+            nnew = bond_forces_2d_lanes.pick(nb, threads)(
                 p.pos, p.vel, p.omega, p.radius, self.i, self.j, self.rb, self.area,
-                self.inertia, self.kn, self.ks, self.tensile, self.cohesion, self.tan_phi,
-                self.fn, self.fs, self.mb, self.normal, self.mode, self.newly, self.brk,
-                self.fbond, self.tbi, self.tbj, sim.dt, length, sim.box.periodic,
-                summed, sim.ext_force, sim.ext_torque, self.screen)
+                self.inertia, self.tensile, self.cohesion, self.tan_phi, self.fn, self.fs,
+                self.mb, self.normal, self.mode, self.newly, self.brk, self.fbond, self.tbi,
+                self.tbj, sim.dt, length, sim.box.periodic, summed, sim.ext_force,
+                sim.ext_torque, self.kc)
         else:
             nnew = bond_forces_3d.pick(nb, threads)(
                 p.pos, p.vel, p.omega, p.radius, self.i, self.j, self.rb, self.area,
@@ -1016,7 +1238,7 @@ class ParallelBonds:
                   self.mb, self.mt, self.normal, self.mode, self.newly, self.brk, self.fbond,
                   self.tbi, self.tbj)
         if self.dim == 2:
-            return BondStep(*arrays, self.screen)
+            return BondStep(*arrays, self.kc)
         return BondStep3D(*arrays, self.kc)
 
     def after_compiled(self, sim: Simulation, state: BondStep | BondStep3D) -> None:
@@ -1108,7 +1330,7 @@ class ParallelBonds:
         self.cstart, self.cbond = bond_csr(self.i, self.j, self.n_particles)
         self.gstart, self.gbond = bond_csr(self.i, self.j, self.n_particles, by_bond=True)
         self.screen = bond_screen(self.area, self.rb, self.inertia)
-        self.kc = self._consts_3d()
+        self.kc = self._consts()
 
     # ------------------------------------------------------------------ checkpoints
     _ARRAYS = ("i", "j", "rb", "area", "inertia", "polar", "kn", "ks", "tensile", "cohesion",

@@ -46,3 +46,15 @@ def min_image(d: float, length: float, periodic: bool) -> float:
             return d + 0.0
         return d - length * np.rint(d / length)
     return d
+
+
+def column_order(pos: np.ndarray, x0: float, cell: float) -> np.ndarray:
+    """A numbering of particles (a permutation of ``range(len(pos))``) column by column
+    along x (columns ``cell`` wide from ``x0``, m), by y within a column: particles
+    within ``cell`` of each other then have indices at most about three columns' count
+    apart, so the pair and bond passes (which walk the particles' arrays by index) read
+    memory that is close together. For a cell much wider than it is high (a periodic
+    strip) this keeps a pass's working set in cache where a random numbering misses it
+    on nearly every pair. Stable: ties keep their order."""
+    col = np.floor((np.asarray(pos[:, 0]) - x0) / cell).astype(np.int64)
+    return np.lexsort((pos[:, 1], col))
