@@ -221,6 +221,42 @@ def test_a_slab_as_wide_as_the_cell_is_delamination_not_wear() -> None:
     assert m["wear_depth_mean_pad_m"] == pytest.approx(area / (it.phi[PAD] * w), rel=1e-12)
 
 
+
+def test_breaks_by_place_counts_the_surface_layer_and_the_bulk() -> None:
+    """``breaks_by_place``: every broken bond is counted once (by body, mode and place:
+    the sums are the mode counts); bonds broken by hand in the pad's lowest particle row
+    (on its rough face) count as surface-layer breaks, bonds broken more than 2.6 mean
+    diameters above the face as bulk; the layer is two mean diameters."""
+    from tribodem.braking.measure import SURFACE_LAYER_DIAMETERS, breaks_by_place
+    from tribodem.dem.bonds import SHEAR
+
+    it = build_interface(SMALL, 0.33e6)
+    p, b = it.sim.p, it.bonds
+    ref = reference(it)
+    dm = 2.0 * float(p.radius.mean())
+    w = it.width
+    nbin = max(1, int(w // (2.0 * float(p.radius.max()))))
+    k = np.minimum((np.mod(p.pos[:, 0], w) / w * nbin).astype(int), nbin - 1)
+    pad = p.group == PAD
+    low = np.full(nbin, np.inf)
+    np.minimum.at(low, k[pad], p.pos[pad, 1] - p.radius[pad])
+    depth = p.pos[:, 1] - low[k]  # centre height above the pad's local face
+    inpad = p.group[b.i] == PAD
+    face = inpad & (depth[b.i] < 0.6 * dm) & (depth[b.j] < 0.6 * dm)
+    deep = inpad & (depth[b.i] > 2.6 * dm) & (depth[b.j] > 2.6 * dm)
+    assert face.sum() > 3 and deep.sum() > 3
+    b.mode[face] = TENSILE
+    b.mode[deep] = SHEAR
+    out = breaks_by_place(it, ref)
+    assert out["broken_bonds_surface_layer_m"] == pytest.approx(SURFACE_LAYER_DIAMETERS * dm)
+    assert out["broken_bonds_pad_surface_tensile"] == face.sum()
+    assert out["broken_bonds_pad_bulk_shear"] == deep.sum()
+    assert out["broken_bonds_pad_bulk_tensile"] == out["broken_bonds_pad_surface_shear"] == 0
+    total = sum(v for key, v in out.items() if key.startswith("broken_bonds_") and
+                key != "broken_bonds_surface_layer_m")
+    assert total == b.broken_count() == face.sum() + deep.sum()
+
+
 def _free_chunk(it, xc: float, n: int) -> np.ndarray:
     """Cut the bonds round the ``n`` pad particles nearest to (xc, pad surface): a debris
     component of the pad; returns its mask."""

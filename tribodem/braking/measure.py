@@ -46,15 +46,20 @@ Definitions (reference state = the loaded interface at the start of sliding):
   thickness of the third-body layer between the matrices.
 - **debris vertical displacement**: max |y - y0| of debris particles (m), the quantity of
   the seed's figures 11-12 displacement maps.
+- **broken bonds by place** (summary only, :func:`breaks_by_place`): per body and mode, in
+  the surface layer (two mean particle diameters under the body's local surface at the
+  start) or in the bulk; the seed describes the pad failing in its surface layer.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from tribodem.braking.model import DISC, EJECTED, PAD, Interface
+from tribodem.dem.bonds import INTACT, SHEAR, TENSILE
 
 #: the measured columns added after checkpoints were first written: the rows of an older
 #: checkpoint hold no value of them (nan there, not zero)
@@ -81,9 +86,11 @@ class Reference:
         return np.where(g == DISC, self.surface[DISC] - (y - r), (y + r) - self.surface[PAD])
 
 
-def mean_surface(pos: np.ndarray, radius: np.ndarray, group: np.ndarray, body: int,
-                 width: float) -> float:
-    """Mean over x-bins (2 r_max wide) of the body's outermost particle surface (m)."""
+def surface_profile(pos: np.ndarray, radius: np.ndarray, group: np.ndarray, body: int,
+                    width: float) -> np.ndarray:
+    """The body's outermost particle surface (m) in each of the cell's x-bins (2 r_max
+    wide; the disc's highest, the pad's lowest particle edge; +-inf in a bin it does not
+    reach)."""
     sel = group == body
     nb = max(1, int(width // (2.0 * float(radius.max()))))
     b = np.minimum((np.mod(pos[sel, 0], width) / width * nb).astype(int), nb - 1)
@@ -93,7 +100,51 @@ def mean_surface(pos: np.ndarray, radius: np.ndarray, group: np.ndarray, body: i
     else:
         top = np.full(nb, np.inf)
         np.minimum.at(top, b, pos[sel, 1] - radius[sel])
+    return top
+
+
+def mean_surface(pos: np.ndarray, radius: np.ndarray, group: np.ndarray, body: int,
+                 width: float) -> float:
+    """Mean over x-bins (2 r_max wide) of the body's outermost particle surface (m)."""
+    top = surface_profile(pos, radius, group, body, width)
     return float(top[np.isfinite(top)].mean())
+
+
+#: the surface layer of ``breaks_by_place``: bonds starting within this many mean particle
+#: diameters of their body's local surface
+SURFACE_LAYER_DIAMETERS = 2.0
+
+
+def breaks_by_place(iface: Interface, ref: Reference,
+                    layer_diameters: float = SURFACE_LAYER_DIAMETERS) -> dict[str, Any]:
+    """Broken bonds by body, mode (tensile, shear) and place: the **surface layer** (the
+    bond's centre started less than ``layer_diameters`` mean particle diameters below its
+    body's local surface: the outermost particle edge of its 2 r_max wide x-bin at the
+    start of sliding, so asperities and pit floors alike) or the **bulk** (deeper).
+    Keys ``broken_bonds_{pad,disc}_{surface,bulk}_{tensile,shear}`` (counts) and
+    ``broken_bonds_surface_layer_m`` (the layer's thickness, m)."""
+    b = iface.bonds
+    w = ref.width
+    layer = layer_diameters * 2.0 * float(ref.radius.mean())
+    out: dict[str, Any] = {"broken_bonds_surface_layer_m": layer}
+    pi, pj = ref.pos[b.i], ref.pos[b.j]
+    dx = pj[:, 0] - pi[:, 0]
+    dx -= w * np.rint(dx / w)
+    xc = np.mod(pi[:, 0] + 0.5 * dx, w)
+    yc = 0.5 * (pi[:, 1] + pj[:, 1])
+    for body, name in ((DISC, "disc"), (PAD, "pad")):
+        top = surface_profile(ref.pos, ref.radius, ref.group, body, w)
+        top = np.where(np.isfinite(top), top, ref.surface[body])
+        nbin = top.size
+        sel = (ref.group[b.i] == body) & (b.mode != INTACT)
+        k = np.minimum((xc[sel] / w * nbin).astype(int), nbin - 1)
+        depth = top[k] - yc[sel] if body == DISC else yc[sel] - top[k]
+        surf = depth < layer
+        for mode, code in (("tensile", TENSILE), ("shear", SHEAR)):
+            m = b.mode[sel] == code
+            out[f"broken_bonds_{name}_surface_{mode}"] = float(np.count_nonzero(m & surf))
+            out[f"broken_bonds_{name}_bulk_{mode}"] = float(np.count_nonzero(m & ~surf))
+    return out
 
 
 def reference(iface: Interface) -> Reference:

@@ -24,7 +24,7 @@ import numpy as np
 from tribodem.braking.conditions import SEED_BRAKING_TIME_S, pressure_to_load, speed_to_rpm
 from tribodem.braking.drive import CONTACT_EVERY
 from tribodem.braking.loop import BrakingLoop
-from tribodem.braking.measure import REMAINING
+from tribodem.braking.measure import REMAINING, breaks_by_place
 from tribodem.braking.model import DISC, EJECTED, PLATE_AREAL_MASS, Interface
 from tribodem.braking.setup import RunSetup
 from tribodem.braking.steady import (
@@ -205,6 +205,7 @@ def run_summary(loop: BrakingLoop) -> dict[str, Any]:
         "feed": loop.feed.summary() if loop.feed is not None else None,
         "outlet_length_m": loop.setup.outlet_length_m,
         **_rate_fields(loop),
+        **breaks_by_place(loop.iface, loop.ref),
         **_cell_fields(loop),
         "wall_time_build_s": wall["build"],
         "wall_time_sliding_s": wall["sliding"],
