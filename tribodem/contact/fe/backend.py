@@ -140,14 +140,14 @@ class FEContactSolver(CcxBackend[Mesh]):
     depth. The rest as :class:`~tribodem.contact.fe.base.CcxBackend`.
 
     ``fe`` (:class:`~tribodem.contact.fe.options.FEOptions`, every field but fe3d's
-    ``cycle_increments`` and ``max_wear_slope``): ``h_over_a`` (element size at the contact
-    / Hertz half-width; own 0.25) and ``size_factor`` (bodies' size / a, >= 10; own 40) of
-    the mesh (the convergence study in docs/fe.md); ``threads``, ``timeout`` (s per ccx
-    job; own 1800 s), ``retries`` (after a non-convergence: :func:`.jobs.attempt_settings`,
-    halved increments, then a softer contact), ``retry_from``, ``loading_friction`` (the
-    friction while seating and loading, :data:`.jobs.LOADING_FRICTION`: ``"auto"``, mu for
-    elastic-plastic bodies and 0.001 for elastic ones), ``cache`` (a folder of finished
-    jobs).
+    ``cycle_increments``, ``max_wear_slope``, ``morph`` and ``max_wear_kink``): ``h_over_a``
+    (element size at the contact / Hertz half-width; own 0.25) and ``size_factor`` (bodies'
+    size / a, >= 10; own 40) of the mesh (the convergence study in docs/fe.md);
+    ``threads``, ``timeout`` (s per ccx job; own 1800 s), ``retries`` (after a
+    non-convergence: :func:`.jobs.attempt_settings`, halved increments, then a softer
+    contact), ``retry_from``, ``loading_friction`` (the friction while seating and loading,
+    :data:`.jobs.LOADING_FRICTION`: ``"auto"``, mu for elastic-plastic bodies and 0.001 for
+    elastic ones), ``cache`` (a folder of finished jobs).
 
     ``material``: ``"elastic"`` or ``"elastic-plastic"`` (both bodies bilinear isotropic
     hardening, ``*PLASTIC``, the ``plastic`` table's law: seed table 5.1, or a plastic
@@ -169,7 +169,8 @@ class FEContactSolver(CcxBackend[Mesh]):
     #: :meth:`capabilities_for` its ``material`` and ``mode``
     capabilities = Capabilities(plastic=True, plastic_every_cycle=True, partial_slip=True,
                                 subsurface=True, contacts=("line",))
-    FE_FIELDS = frozenset(FEOptions.model_fields) - {"cycle_increments", "max_wear_slope"}
+    FE_FIELDS = frozenset(FEOptions.model_fields) - {"cycle_increments", "max_wear_slope",
+                                                     "morph", "max_wear_kink"}
     OWN_DEFAULTS = {"h_over_a": FRETTING_H_OVER_A, "size_factor": 40.0, "timeout": 1800.0}
     MODES = MODES
     SOLVES = "a line contact only (2D plane strain)"

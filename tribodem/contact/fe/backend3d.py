@@ -25,11 +25,14 @@ a continuous test has there; for elastic bodies that is the steady Mindlin-Deres
 (docs/fe3d.md "fe3d vs half-space"). It costs two more quarters per job. Plastic strain is
 primed by that half cycle only (not accumulated over the run).
 
-Worn geometry (seed eqs 3.7-3.8): the worn depth of each body at each node column (i, j) is
-its recession (from :meth:`set_surfaces`) minus the unworn one (the case's), at the
-column's (x, y) (upper: its own frame, over the window; lower: lab frame, over the window plus
-the stroke); the surface node moves into its body by that depth and the fine-section nodes
-below it are redistributed proportionally (x, y unchanged, :func:`morph_columns3d`);
+Worn geometry (seed eqs 3.7-3.8): the worn depth of each body (its recession from
+:meth:`set_surfaces` minus the unworn one, the case's) is read on the fretting loop's cells
+(upper: its own frame, the window; lower: lab frame, the window plus the stroke) and each
+node column (i, j) takes its tributary share of their volume (``[fe] morph = "tributary"``,
+:func:`.mesh.tributary_depths`: the mesh loses the maps' volume to rounding), relaxed to
+``max_wear_slope`` and smoothed to ``max_wear_kink`` volume for volume (:mod:`.slope`); the
+surface node moves into its body by that depth and the fine-section nodes below it are
+redistributed proportionally (x, y unchanged, :func:`morph_columns3d`);
 :meth:`FE3DContactSolver.worn_volume` is the exact volume lost by the morphed hexahedra.
 
 Fields on the contract's ``n x n`` window (the upper body's frame, base.py), the half model
@@ -97,10 +100,11 @@ from tribodem.contact.fe.deck import (
     write_time_points,
 )
 from tribodem.contact.fe.jobs import checked_increments
+from tribodem.contact.fe.mesh import tributary_depths, worn_depth
 from tribodem.contact.fe.options import CONVERGED_SLOPE as CONVERGED_SLOPE
 from tribodem.contact.fe.options import FEOptions
 from tribodem.contact.fe.results import DatBlock, read_dat
-from tribodem.contact.fe.slope import SlopeLimit, limit_slope, steepest
+from tribodem.contact.fe.slope import KinkLimit, SlopeLimit, limit_kink, limit_slope, steepest
 from tribodem.contact.geometry import HertzSphere
 
 if TYPE_CHECKING:
@@ -126,6 +130,11 @@ PENALTY_FACTOR = 10.0
 REVERSAL_SLIDE = 0.25
 #: modes of :class:`FE3DContactSolver` (``chained`` is the 2D backend's only)
 MODES = ("fresh", "primed")
+#: how the wear maps become the columns' depths (``[fe] morph``): ``tributary``, each surface
+#: node's exact share of every wear-map cell's volume (:func:`.mesh.tributary_depths`);
+#: ``projection``, the lumped projection of the interpolated surface sampled at dx / 2
+#: (:func:`.mesh.surface_projection`, the base class's)
+MORPHS = ("tributary", "projection")
 
 #: trilinear shape functions of the C3D8 nodes at its 2x2x2 Gauss points, [8 gp, 8 nodes];
 #: its inverse extrapolates Gauss-point values to the nodes
@@ -277,10 +286,14 @@ class FE3DContactSolver(CcxBackend[Mesh3D]):
     elastic-plastic bodies and 0.001 for elastic ones), ``cache``; ``max_wear_slope``: the
     steepest worn-depth step / column spacing the morphed mesh carries
     (:func:`.slope.limit_slope`, volume kept; default :data:`CONVERGED_SLOPE`; None: the
-    criterion's surface as projected); ``cycle_increments``: the fewest ccx increments per
-    cycle, the output times staying the loop's ``n_increments`` (None: ``n_increments``,
-    and ``plastic_increments`` for elastic-plastic bodies; the quick preset's 64 took 443
-    -> 299 Newton iterations a cycle, docs/fe3d.md "Contact set-up", quick preset);
+    criterion's surface as projected); ``morph``: how the wear maps become column depths
+    (:data:`MORPHS`); ``max_wear_kink``: the largest change of slope at a node the morphed
+    mesh carries (:func:`.slope.limit_kink`, volume kept; default
+    :data:`~.options.DEFAULT_KINK`; None: no smoothing); ``cycle_increments``: the fewest
+    ccx increments per cycle, the output times staying the loop's ``n_increments`` (None:
+    ``n_increments``, and ``plastic_increments`` for elastic-plastic bodies; the quick
+    preset's 64 took 443 -> 299 Newton iterations a cycle, docs/fe3d.md "Contact set-up",
+    quick preset);
     ``mode`` ``"fresh"`` or ``"primed"``; ``material`` ``"elastic"`` or
     ``"elastic-plastic"`` (the ``plastic`` table's law, bilinear EN24T by default, fresh
     cycles; ``beyond_uts``: past the UTS the hardening line goes on, ``"line"``, or the
@@ -351,6 +364,19 @@ class FE3DContactSolver(CcxBackend[Mesh3D]):
         #: the steepest worn-depth step / column spacing the morphed mesh carries (None: the
         #: criterion's surface as projected; :func:`.slope.limit_slope`)
         self.max_wear_slope = None if max_wear_slope is None else float(max_wear_slope)
+        kink = fe.max_wear_kink
+        if kink is not None and not (math.isfinite(kink) and kink > 0.0):
+            raise ValueError(f"max_wear_kink = {kink!r} is not allowed: a number > 0 (the "
+                             "largest change of slope at a node the mesh carries) or None "
+                             "(off)")
+        #: the largest change of slope at a node column the morphed mesh carries (None: no
+        #: smoothing; :func:`.slope.limit_kink`)
+        self.max_wear_kink = None if kink is None else float(kink)
+        if fe.morph not in MORPHS:
+            raise ValueError(f"morph = {fe.morph!r} is not allowed: allowed: "
+                             + ", ".join(MORPHS))
+        #: how the wear maps become column depths (:data:`MORPHS`)
+        self.morph = fe.morph
 
     def _radius_of(self, upper: Recession, lower: Recession) -> float:
         """R = 2 / (the upper's curvature along x + the lower's along y): crossed cylinders
@@ -413,6 +439,8 @@ class FE3DContactSolver(CcxBackend[Mesh3D]):
         self._complete = count[self._cols["upper"][..., 0]] == 0.0
         #: per body, what ``max_wear_slope`` did to the last :meth:`column_wear`
         self.slope_limits: dict[str, SlopeLimit] = {}
+        #: per body, what ``max_wear_kink`` did to the last :meth:`column_wear`
+        self.kink_limits: dict[str, KinkLimit] = {}
         self._loaded_result: IncrementResult | None = None
         self._debris_pressure = np.zeros((self.n, self.n))  # prescribed debris pressure, Pa
         self._debris_load = 0.0
@@ -469,14 +497,45 @@ class FE3DContactSolver(CcxBackend[Mesh3D]):
         xs, ys = self._grids[body]
         return xs, ys, float(self.coords[-1])
 
+    def _column_depths(self, body: str, now: Recession, base: Recession, lo: float,
+                       hi: float) -> NDArray[np.float64]:
+        """``morph = "tributary"``: the worn depth ``now - base`` (clipped at zero) read on
+        the fretting loop's cells (the window's points for the upper body, the track's, the
+        window widened by :attr:`pad`, for the lower; at a cell's centre the loop's height
+        map returns its own value) and carried onto the half model's columns by each
+        node's exact share of every cell's volume, y folded onto y >= 0
+        (:func:`.mesh.tributary_depths`): the morphed mesh loses sum(d) dx^2, the loop's
+        worn volume, to rounding. ``"projection"``: the base class's lumped projection
+        (``lo``, ``hi``: the x range, m)."""
+        if self.morph == "projection":
+            return super()._column_depths(body, now, base, lo, hi)
+        c, dx = self.coords, self.dx
+        k = int(round(self.pad / dx)) if body == "lower" else 0
+        x = (np.arange(c.size + 2 * k) - c.size // 2 - k) * dx
+        gx, gy = np.meshgrid(x, c)
+        d = worn_depth(now, base)(gx.ravel(), gy.ravel()).reshape(gx.shape)
+        xs, ys = self._grids[body]
+        try:
+            return tributary_depths(d, x, c, dx, dx, xs, ys, fold_y=True)
+        except ValueError as err:
+            raise FESolverStopped(f"mesh morphing ({body} body): {err}") from None
+
     def _relaxed(self, body: str, wear: NDArray[np.float64]) -> NDArray[np.float64]:
         """With ``max_wear_slope`` the depths relaxed, volume for volume, until no step
-        between neighbouring columns is steeper (:func:`.slope.limit_slope`; what it did per
-        body in :attr:`slope_limits`)."""
+        between neighbouring columns is steeper (:func:`.slope.limit_slope`), then with
+        ``max_wear_kink`` smoothed, volume for volume, until no node's change of slope
+        exceeds it, the slope limit kept (:func:`.slope.limit_kink`, the y = 0 row a
+        symmetry line); what they did per body in :attr:`slope_limits` and
+        :attr:`kink_limits`."""
         if self.max_wear_slope is not None and wear.any():
             wear, lim = limit_slope(wear, *self._grids[body], self._areas[body],
                                     self.max_wear_slope)
             self.slope_limits[body] = lim
+        if self.max_wear_kink is not None and wear.any():
+            slope = np.inf if self.max_wear_slope is None else self.max_wear_slope
+            wear, kl = limit_kink(wear, *self._grids[body], self._areas[body],
+                                  self.max_wear_kink, slope, mirror_y0=True)
+            self.kink_limits[body] = kl
         return wear
 
     def _morph(self, mesh: Mesh3D, body: str, wear: NDArray[np.float64]) -> Mesh3D:
@@ -1067,6 +1126,16 @@ class FE3DContactSolver(CcxBackend[Mesh3D]):
                           "moved_volume_m3": 2.0 * lim.moved_volume,  # both halves
                           "worn_volume_m3": self.worn_volume(body), "converged": lim.converged}
                    for body, lim in self.slope_limits.items()}}
+        if self.max_wear_kink is not None and self.kink_limits:
+            # and smoothed to max_wear_kink: the largest change of slope before and after
+            row["wear_kink_limit"] = {
+                "max_wear_kink": self.max_wear_kink,
+                **{body: {"kink_before": kl.kink_before, "kink_after": kl.kink_after,
+                          "steepest_after": kl.steepest_after,
+                          "moved_volume_m3": 2.0 * kl.moved_volume,  # both halves
+                          "worn_volume_m3": self.worn_volume(body), "converged": kl.converged}
+                   for body, kl in self.kink_limits.items()}}
+        row["morph"] = self.morph
         return row
 
     def _peak_stresses(self, times: list[float]) -> dict[str, float]:
@@ -1116,15 +1185,23 @@ class FE3DContactSolver(CcxBackend[Mesh3D]):
 
     def _worn_surface_reading(self) -> str:
         """Which worn surface the jobs' meshes carry (for summary.json)."""
-        if self.max_wear_slope is None:
-            return ("the criterion's worn depth, lumped-projected onto the node columns "
-                    "(eqs 3.7-3.8)")
-        return (f"the criterion's worn depth, lumped-projected onto the node columns, then "
-                f"relaxed volume for volume until no step between neighbouring columns is "
-                f"steeper than {self.max_wear_slope:g} x their spacing (fe.max_wear_slope): "
-                "the FE geometry is smoother than the scar the loop reports; per cycle "
-                "'wear_slope_limit' gives the steepest step before and after and the volume "
-                "moved")
+        text = ("the criterion's worn depth maps, each node column moved by its exact share "
+                "of the maps' cell volumes over its tributary area (fe.morph = 'tributary'; "
+                "the mesh loses the maps' volume to rounding)" if self.morph == "tributary"
+                else "the criterion's worn depth, lumped-projected onto the node columns "
+                "(fe.morph = 'projection')") + " (eqs 3.7-3.8)"
+        if self.max_wear_slope is not None:
+            text += (f", then relaxed volume for volume until no step between neighbouring "
+                     f"columns is steeper than {self.max_wear_slope:g} x their spacing "
+                     "(fe.max_wear_slope; per cycle 'wear_slope_limit': the steepest step "
+                     "before and after and the volume moved)")
+        if self.max_wear_kink is not None:
+            text += (f", then smoothed volume for volume until no node's change of slope "
+                     f"exceeds {self.max_wear_kink:g} (fe.max_wear_kink; per cycle "
+                     "'wear_kink_limit': the largest before and after and the volume moved)")
+        if self.max_wear_slope is not None or self.max_wear_kink is not None:
+            text += ": the FE geometry is smoother than the scar the loop reports"
+        return text
 
     def _report_extra(self) -> dict[str, Any]:
         """The mesh (elements, fine element size m, size factor), the slope limit and which
@@ -1132,6 +1209,7 @@ class FE3DContactSolver(CcxBackend[Mesh3D]):
         return {"fe3d": {"elements": int(self._mesh0.elements.shape[0]),
                          "h_fine_m": self._mesh0.h_fine, "size_factor": self.size_factor,
                          "max_wear_slope": self.max_wear_slope,
+                         "max_wear_kink": self.max_wear_kink, "morph": self.morph,
                          "worn_surface": self._worn_surface_reading()}}
 
     # -- resume ---------------------------------------------------------------------------

@@ -445,23 +445,30 @@ class CcxBackend(CcxJobs, FirstBodySolver, Generic[MeshT]):
         return min(self.PLASTIC_DEPTH_RADII * self.hertz[1], self.stress_depth)
 
     def column_wear(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """Worn depth (m, >= 0) of each node column of the (upper, lower) mesh: the lumped
-        projection (:func:`surface_projection`, sampled at dx / 2) of the current recession
-        minus the unworn one (upper: its own frame, lower: lab frame, clipped at zero) onto
-        the surface nodes; zero outside the window (upper) and the window plus the stroke
-        (lower) along x, and beyond the window's last point along y, where the loop gives
-        no surface. The morphed mesh so loses the loop's worn volume (what a backend does
-        to it then: :meth:`_relaxed`)."""
+        """Worn depth (m, >= 0) of each node column of the (upper, lower) mesh: the current
+        recession minus the unworn one (upper: its own frame, lower: lab frame, clipped at
+        zero) carried onto the surface nodes (:meth:`_column_depths`: by default the lumped
+        projection, :func:`surface_projection`, sampled at dx / 2); zero outside the window
+        (upper) and the window plus the stroke (lower) along x, and beyond the window's last
+        point along y, where the loop gives no surface. The morphed mesh so loses the loop's
+        worn volume (what a backend does to it then: :meth:`_relaxed`)."""
         c = self.coords
         out = []
         for body, now, base, lo, hi in (
                 ("upper", self.upper, self._base_upper, c[0], c[-1]),
                 ("lower", self.lower, self._base_lower, c[0] - self.pad, c[-1] + self.pad)):
-            xs, ys, y_hi = self._projection_grid(body)
-            w = surface_projection(worn_depth(now, base), xs, ys, (lo, hi, -np.inf, y_hi),
-                                   0.5 * self.dx)
-            out.append(self._relaxed(body, w))
+            out.append(self._relaxed(body, self._column_depths(body, now, base, lo, hi)))
         return out[0], out[1]
+
+    def _column_depths(self, body: str, now: Recession, base: Recession, lo: float,
+                       hi: float) -> NDArray[np.float64]:
+        """``body``'s worn depth (m, >= 0) at its node columns, before :meth:`_relaxed`:
+        the lumped projection of ``now`` minus ``base`` (clipped at zero) onto the surface
+        nodes, sampled at dx / 2 on x in [``lo``, ``hi``] (m) and y up to the window's last
+        point (:func:`surface_projection`)."""
+        xs, ys, y_hi = self._projection_grid(body)
+        return surface_projection(worn_depth(now, base), xs, ys, (lo, hi, -np.inf, y_hi),
+                                  0.5 * self.dx)
 
     def morphed_mesh(self) -> MeshT:
         """The unworn mesh with both surfaces receded by :meth:`column_wear` (eqs 3.7-3.8;

@@ -346,3 +346,75 @@ def element_areas(mesh: Mesh) -> NDArray[np.float64]:
     p = mesh.nodes[mesh.elements]
     x, y = p[..., 0], p[..., 1]
     return 0.5 * np.sum(x * np.roll(y, -1, axis=1) - np.roll(x, -1, axis=1) * y, axis=1)
+
+
+def hat_integrals(nodes: NDArray[np.float64], lo: NDArray[np.float64], hi: NDArray[np.float64]
+                  ) -> NDArray[np.float64]:
+    """Exact integrals (m) of the piecewise-linear hat functions phi_i of the sorted node
+    line ``nodes`` (m; phi_i = 1 at node i, 0 at the others, linear between, zero outside
+    [nodes[0], nodes[-1]]: the end nodes have one half only) over the intervals
+    [lo_k, hi_k] (m, lo <= hi): [n_nodes, n_intervals],
+    int_lo^hi phi_i dx = Phi_i(hi) - Phi_i(lo) with the antiderivative
+    Phi_i(x) = (x - x_{i-1})^2 / (2 h_l) on [x_{i-1}, x_i],
+    h_l / 2 + h_r / 2 - (x_{i+1} - x)^2 / (2 h_r) on [x_i, x_{i+1}] (h_l, h_r the element
+    lengths left and right of node i), constant outside. A column sums to the length of
+    [lo, hi] inside the node line (the hats are a partition of unity there)."""
+    x = np.asarray(nodes, dtype=float)
+    h = np.diff(x)
+    hl = np.concatenate([[0.0], h])[:, None]  # element left of node i (0 at the first)
+    hr = np.concatenate([h, [0.0]])[:, None]
+    xi = x[:, None]
+
+    def antiderivative(t: NDArray[np.float64]) -> NDArray[np.float64]:
+        t = np.asarray(t, dtype=float)[None, :]
+        left = np.clip(t - (xi - hl), 0.0, hl)  # distance into the left element
+        right = np.clip((xi + hr) - t, 0.0, hr)  # distance left before the right end
+        with np.errstate(divide="ignore", invalid="ignore"):
+            f_left = np.where(hl > 0, left * left / (2.0 * np.where(hl > 0, hl, 1.0)), 0.0)
+            f_right = np.where(hr > 0, right * right / (2.0 * np.where(hr > 0, hr, 1.0)), 0.0)
+        # Phi = (rising part so far) + (falling part so far) = f_left + (h_r / 2 - f_right)
+        # on the right of x_i; left of x_i, right = h_r and the second term is 0
+        return f_left + 0.5 * hr - f_right
+
+    return antiderivative(hi) - antiderivative(lo)
+
+
+def tributary_depths(depth: NDArray[np.float64], x: NDArray[np.float64],
+                     y: NDArray[np.float64], dx: float, dy: float, xs: NDArray[np.float64],
+                     ys: NDArray[np.float64], fold_y: bool = False) -> NDArray[np.float64]:
+    """Nodal depths (m, [len(ys), len(xs)]) that carry a wear map's volume node by node:
+    the map ``depth`` (m, [len(y), len(x)], >= 0) is piecewise constant on cells of
+    ``dx`` x ``dy`` (m) centred on its points ``x`` x ``y`` (m; the fretting loop's grids,
+    whose volume is sum(depth) dx dy); each cell's volume goes to the surface nodes of the
+    grid ``xs`` x ``ys`` (m, sorted) in proportion to the integral of their bilinear shape
+    function over the cell (exact, :func:`hat_integrals`), and each node's depth is its
+    share over its tributary area: w_i = sum_k d_k int_cell_k phi_i dA / int phi_i dA.
+
+    Node-column morphing (eqs 3.7-3.8) with these depths removes exactly the map's volume,
+    sum_i w_i A_i = sum_k d_k dx dy (the shape functions are a partition of unity over the
+    cells; to rounding), and every depth is a weighted mean of the cells it touches (>= 0,
+    at most the deepest). ``fold_y``: the node grid is the half model y >= 0 (``ys[0]`` =
+    0) of a body symmetric about y = 0: the map is folded onto it, (d(x, y) + d(x, -y)) / 2,
+    so the half carries exactly half the map's volume, symmetric or not. ``ValueError``
+    when a worn cell reaches outside the node grid (its volume would be lost)."""
+    d = np.asarray(depth, dtype=float)
+    x = np.asarray(x, dtype=float)
+    y = np.asarray(y, dtype=float)
+    if d.shape != (y.size, x.size):
+        raise ValueError(f"depth has shape {d.shape}: expected ({y.size}, {x.size}) (y, x)")
+    wx = hat_integrals(xs, x - 0.5 * dx, x + 0.5 * dx)
+    if fold_y:
+        wy = 0.5 * (hat_integrals(ys, y - 0.5 * dy, y + 0.5 * dy)
+                    + hat_integrals(ys, -y - 0.5 * dy, -y + 0.5 * dy))
+    else:
+        wy = hat_integrals(ys, y - 0.5 * dy, y + 0.5 * dy)
+    worn = d > 0.0
+    cover = np.outer(wy.sum(axis=0) / dy, wx.sum(axis=0) / dx)
+    if np.any(worn & (np.abs(cover - (0.5 if fold_y else 1.0)) > 1e-9)):
+        j, i = np.argwhere(worn & (np.abs(cover - (0.5 if fold_y else 1.0)) > 1e-9))[0]
+        raise ValueError(f"worn cell at (x, y) = ({x[i]:.4g}, {y[j]:.4g}) m is not inside "
+                         f"the mesh's surface grid x in [{xs[0]:.4g}, {xs[-1]:.4g}], y in "
+                         f"[{ys[0]:.4g}, {ys[-1]:.4g}] m: its volume would be lost")
+    lx = hat_integrals(xs, np.array([xs[0]]), np.array([xs[-1]]))[:, 0]
+    ly = hat_integrals(ys, np.array([ys[0]]), np.array([ys[-1]]))[:, 0]
+    return (wy @ d @ wx.T) / np.outer(ly, lx)

@@ -23,6 +23,12 @@ PLASTIC_MIN_INCREMENTS = 32
 #: cycle 3 on 0.22 / 0.24 did not, h = a/3); a job that fails on steeper surfaces says so
 CONVERGED_SLOPE = 0.1
 
+#: the largest change of slope at a node (the angle by which the worn surface's facets turn
+#: between neighbouring node columns, rad for small slopes) the fe3d morph leaves; the
+#: unworn R 4 mm cylinder turns by h / R = 0.011 per 44 um element, the seed's shear scar
+#: after 7 cycles, slope-limited, by up to 0.17 / 0.20 (upper / lower; docs/fe3d.md "Worn
+#: geometry")
+DEFAULT_KINK = 0.03
 
 
 class FEOptions(StrictModel):
@@ -84,6 +90,34 @@ class FEOptions(StrictModel):
         "steps are relaxed volume for volume (contact.fe.slope; the default is the steepest "
         "on which ccx's contact converged, measured; 'off': the criterion's surface as "
         "projected, docs/fe3d.md 'Worn geometry')")
+
+    morph: Literal["tributary", "projection"] = Field(
+        "tributary", description="fe3d: how the wear maps become the depths the surface "
+        "node columns move by (eqs 3.7-3.8). tributary: each node takes its share of every "
+        "wear-map cell's volume (the exact integral of its bilinear shape function over the "
+        "cell) over its tributary area, so the mesh loses the maps' volume exactly; "
+        "projection: the lumped projection of the interpolated worn surface sampled at dx / 2 "
+        "(within ~0.05 %, the morph before it; docs/fe3d.md 'Worn geometry')")
+    max_wear_kink: float | None = Field(
+        DEFAULT_KINK, description="fe3d: the largest change of slope of the morphed worn "
+        "surface at a node column between its neighbours along x or y (dimensionless, the "
+        "facets' turn in rad); beyond it the depths are smoothed volume for volume, after "
+        "max_wear_slope (contact.fe.slope.limit_kink; 'off': none; the unworn cylinder turns "
+        "by h / R = 0.011 per element at h = a/3; docs/fe3d.md 'Worn geometry')")
+
+    @field_validator("max_wear_kink", mode="before")
+    @classmethod
+    def _kink_or_off(cls, v: Any) -> float | None:
+        if v == "off" or v is None:
+            return None
+        if isinstance(v, bool) or not isinstance(v, int | float) or not 0 < v <= 10:
+            raise ValueError("allowed: a number > 0 and <= 10 (a change of slope), or 'off'")
+        return float(v)
+
+    @field_serializer("max_wear_kink", when_used="json")
+    def _kink_off(self, v: float | None) -> float | str:
+        """Recorded as 'off', not None (as ``max_wear_slope``)."""
+        return "off" if v is None else v
 
     @field_validator("max_wear_slope", mode="before")
     @classmethod

@@ -133,3 +133,154 @@ def limit_slope(depth: NDArray[np.float64], xs: NDArray[np.float64], ys: NDArray
     return w, SlopeLimit(steepest_before=before, steepest_after=steepest(w, xs, ys),
                          moved_volume=moved, sweeps=sweeps if sweeps >= 0 else MAX_SWEEPS,
                          converged=sweeps >= 0)
+
+
+@dataclass(frozen=True)
+class KinkLimit:
+    """What :func:`limit_kink` did: ``kink_before`` / ``kink_after`` (the largest change of
+    slope at a node between its two edges along x or y, dimensionless), ``steepest_after``
+    (the largest |step| / edge length after it), ``moved_volume`` (m^3 on the grid's areas:
+    half the L1 change of w x A), ``sweeps``, ``converged``."""
+
+    kink_before: float
+    kink_after: float
+    steepest_after: float
+    moved_volume: float
+    sweeps: int
+    converged: bool
+
+
+@njit(cache=True)
+def _kinks(w, xs, ys, mirror_y0):  # pragma: no cover - numba
+    """The largest |change of slope| at a node along x and y (with ``mirror_y0`` the row
+    j = 0 is a symmetry line: its slope towards the mirror image is minus the one to j = 1)."""
+    ny, nx = w.shape
+    k = 0.0
+    for j in range(ny):
+        for i in range(nx):
+            if 0 < i < nx - 1:
+                sl = (w[j, i] - w[j, i - 1]) / (xs[i] - xs[i - 1])
+                sr = (w[j, i + 1] - w[j, i]) / (xs[i + 1] - xs[i])
+                k = max(k, abs(sr - sl))
+            if 0 < j < ny - 1:
+                sl = (w[j, i] - w[j - 1, i]) / (ys[j] - ys[j - 1])
+                sr = (w[j + 1, i] - w[j, i]) / (ys[j + 1] - ys[j])
+                k = max(k, abs(sr - sl))
+            elif j == 0 and mirror_y0 and ny > 1:
+                k = max(k, 2.0 * abs(w[1, i] - w[0, i]) / (ys[1] - ys[0]))
+    return k
+
+
+@njit(cache=True)
+def _smooth(w, xs, ys, area, kink, slope, tol, max_sweeps, mirror_y0):  # pragma: no cover
+    """Jacobi sweeps of a conservative diffusion on the edges next to a node whose kink
+    exceeds ``kink`` or steeper than ``slope`` (``w`` in place); the sweeps done, or -1."""
+    ny, nx = w.shape
+    dw = np.zeros_like(w)
+    ax = np.zeros((ny, nx), dtype=np.bool_)  # edge (j, i)-(j, i + 1) active
+    ay = np.zeros((ny, nx), dtype=np.bool_)  # edge (j, i)-(j + 1, i) active
+    for sweep in range(max_sweeps):
+        ax[:, :] = False
+        ay[:, :] = False
+        found = False
+        for j in range(ny):
+            for i in range(nx):
+                if 0 < i < nx - 1:
+                    sl = (w[j, i] - w[j, i - 1]) / (xs[i] - xs[i - 1])
+                    sr = (w[j, i + 1] - w[j, i]) / (xs[i + 1] - xs[i])
+                    if abs(sr - sl) > kink * (1.0 + tol):
+                        ax[j, i - 1] = True
+                        ax[j, i] = True
+                        found = True
+                if i + 1 < nx and abs(w[j, i + 1] - w[j, i]) > (
+                        slope * (1.0 + tol) * (xs[i + 1] - xs[i])):
+                    ax[j, i] = True
+                    found = True
+                if 0 < j < ny - 1:
+                    sl = (w[j, i] - w[j - 1, i]) / (ys[j] - ys[j - 1])
+                    sr = (w[j + 1, i] - w[j, i]) / (ys[j + 1] - ys[j])
+                    if abs(sr - sl) > kink * (1.0 + tol):
+                        ay[j - 1, i] = True
+                        ay[j, i] = True
+                        found = True
+                elif j == 0 and mirror_y0 and ny > 1:
+                    if 2.0 * abs(w[1, i] - w[0, i]) / (ys[1] - ys[0]) > kink * (1.0 + tol):
+                        ay[0, i] = True
+                        found = True
+                if j + 1 < ny and abs(w[j + 1, i] - w[j, i]) > (
+                        slope * (1.0 + tol) * (ys[j + 1] - ys[j])):
+                    ay[j, i] = True
+                    found = True
+        if not found:
+            return sweep
+        dw[:, :] = 0.0
+        for j in range(ny):
+            for i in range(nx):
+                for e in range(2):
+                    if e == 0:
+                        if i + 1 >= nx or not ax[j, i]:
+                            continue
+                        jj, ii = j, i + 1
+                    else:
+                        if j + 1 >= ny or not ay[j, i]:
+                            continue
+                        jj, ii = j + 1, i
+                    # a quarter of the volume that would level the edge, from the deeper
+                    # node to the shallower: four edges a node at most, so every new depth
+                    # is a convex combination of the old ones (>= 0, no overshoot)
+                    dv = 0.25 * (w[j, i] - w[jj, ii]) / (1.0 / area[j, i] + 1.0 / area[jj, ii])
+                    dw[j, i] -= dv / area[j, i]
+                    dw[jj, ii] += dv / area[jj, ii]
+        for j in range(ny):
+            for i in range(nx):
+                w[j, i] += dw[j, i]
+    return -1
+
+
+def kinks(depth: NDArray[np.float64], xs: NDArray[np.float64], ys: NDArray[np.float64],
+          mirror_y0: bool = False) -> float:
+    """The largest change of slope of ``depth`` ([ny, nx], m) at a node of the grid ``xs``
+    x ``ys`` (m) between its two edges along x or along y, |s_right - s_left| with s the
+    step / spacing (dimensionless: the angle by which the facets of a column surface turn
+    there, for small slopes); ``mirror_y0``: row 0 lies on a symmetry plane (its edge to
+    the mirror image has minus the slope of its edge to row 1)."""
+    return float(_kinks(np.ascontiguousarray(depth, dtype=float),
+                        np.ascontiguousarray(xs, dtype=float),
+                        np.ascontiguousarray(ys, dtype=float), bool(mirror_y0)))
+
+
+def limit_kink(depth: NDArray[np.float64], xs: NDArray[np.float64], ys: NDArray[np.float64],
+               area: NDArray[np.float64], kink: float, slope: float = np.inf,
+               mirror_y0: bool = False) -> tuple[NDArray[np.float64], KinkLimit]:
+    """``depth`` (m, [ny, nx], >= 0, on the grid ``xs`` x ``ys``, m) smoothed, volume for
+    volume, until no node's change of slope (:func:`kinks`) exceeds ``kink`` and no step
+    exceeds ``slope`` x its spacing (dimensionless, > 0), within :data:`TOLERANCE`.
+
+    A conservative diffusion on the offending edges only: in each Jacobi sweep every edge
+    next to a node kinked beyond ``kink`` (or itself steeper than ``slope``) carries a
+    quarter of the volume that would level it, dv = (w_i - w_j) / (4 (1 / A_i + 1 / A_j)),
+    from the deeper node to the shallower (``area`` the tributary areas A, m^2), so
+    sum(w A), the worn volume, is unchanged to rounding, every new depth is a convex
+    combination of old ones (>= 0, never deeper than the deepest), and a surface within
+    both limits is returned bit for bit. The sweeps stop when nothing exceeds the limits
+    (``converged``) or after :data:`MAX_SWEEPS` (still volume-exact)."""
+    w0 = np.ascontiguousarray(depth, dtype=float)
+    xs = np.ascontiguousarray(xs, dtype=float)
+    ys = np.ascontiguousarray(ys, dtype=float)
+    area = np.ascontiguousarray(area, dtype=float)
+    if w0.shape != (ys.size, xs.size) or area.shape != w0.shape:
+        raise ValueError(f"depth {w0.shape} and area {area.shape} must be (ny, nx) = "
+                         f"({ys.size}, {xs.size})")
+    for name, v in (("kink", kink), ("slope", slope)):
+        if not (v > 0.0) or np.isnan(v):
+            raise ValueError(f"{name} = {v!r} is not allowed: a number > 0")
+    if np.any(np.diff(xs) <= 0) or np.any(np.diff(ys) <= 0) or np.any(area <= 0):
+        raise ValueError("xs and ys must increase and the areas be > 0")
+    before = kinks(w0, xs, ys, mirror_y0)
+    w = w0.copy()
+    sweeps = int(_smooth(w, xs, ys, area, float(kink), float(slope), TOLERANCE, MAX_SWEEPS,
+                         bool(mirror_y0)))
+    moved = 0.5 * float(np.abs((w - w0) * area).sum())
+    return w, KinkLimit(kink_before=before, kink_after=kinks(w, xs, ys, mirror_y0),
+                        steepest_after=steepest(w, xs, ys), moved_volume=moved,
+                        sweeps=sweeps if sweeps >= 0 else MAX_SWEEPS, converged=sweeps >= 0)
