@@ -132,7 +132,7 @@ def test_bad_options_exit_2(args, msg):
 @pytest.mark.parametrize("args, msg", [
     (["--strategy", "polynomial", "--param", "q_y=abc"], "expected float"),
     (["--strategy", "polynomial", "--param", "degree=2.5"], "expected int"),
-    (["--strategy", "polynomial", "--param", "taylor_order=3"], "taylor_order must be"),
+    (["--strategy", "polynomial", "--param", "taylor_order=3"], "taylor_order = 3: must be"),
     (["--strategy", "constant", "--param", "jump_length"], "expected key=value"),
     (["--strategy", "moving", "--param", "moving_window=1"], "not a parameter"),
 ])

@@ -240,7 +240,7 @@ REFUSALS: list[tuple[str, str, dict | list[str], str, list[str]]] = [
     ("jump-param-value", "jump",
      ["replay", "--strategy", "constant", "--input",
       str(ROOT / "examples" / "wear_increments_two_phase.csv"), "--param", "jump_length=-5"],
-     "none", ["--param jump_length=-5", "jump_length must be >= 1"]),
+     "none", ["--param jump_length=-5", "jump_length = -5: must be >= 1"]),
     ("sweep-load-inf", "sweep", ["contact.load", "100", "inf"], "new",
      ["--table", "row 2", "contact.load", "inf", "finite"]),
     ("sweep-young-1e300", "sweep", ["contact.young", "2e11", "1e300"], "new",

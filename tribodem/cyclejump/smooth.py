@@ -302,25 +302,29 @@ class SmoothJump(JumpStrategy):
         decide_on: str = "total",
     ) -> None:
         if not (math.isfinite(tol) and tol > 0):
-            raise ValueError("tol must be a finite number > 0 (relative local error per jump)")
+            raise ValueError(f"tol = {tol!r}: must be a finite number > 0 (relative local error "
+                             "per jump)")
         if degree not in range(1, MAX_DEGREE + 1):
-            raise ValueError(f"degree must be 1..{MAX_DEGREE} (2: the cubic w(n) of eq 4.7)")
+            raise ValueError(f"degree = {degree!r}: must be 1..{MAX_DEGREE} (2: the cubic w(n) of "
+                             "eq 4.7)")
         if foundation_cycles < degree + 3:
-            raise ValueError(f"foundation_cycles must be >= degree + 3 = {degree + 3}")
+            raise ValueError(f"foundation_cycles = {foundation_cycles!r}: must be >= degree + 3 "
+                             f"= {degree + 3}")
         if not 0.0 < window_fraction <= 1.0:
-            raise ValueError("window_fraction must be in (0, 1]")
+            raise ValueError(f"window_fraction = {window_fraction!r}: must be in (0, 1]")
         if not window_growth > 1.0:
-            raise ValueError("window_growth must be > 1")
+            raise ValueError(f"window_growth = {window_growth!r}: must be > 1")
         if not (math.isfinite(confidence) and confidence > 0):
-            raise ValueError("confidence must be a finite number > 0")
+            raise ValueError(f"confidence = {confidence!r}: must be a finite number > 0")
         if not 0.0 < safety <= 1.0:
-            raise ValueError("safety must be in (0, 1]")
+            raise ValueError(f"safety = {safety!r}: must be in (0, 1]")
         if rate_tol is not None and not (math.isfinite(rate_tol) and rate_tol > 0):
-            raise ValueError("rate_tol must be None or a finite number > 0")
+            raise ValueError(f"rate_tol = {rate_tol!r}: must be None or a finite number > 0")
         if min_jump < 1:
-            raise ValueError("min_jump must be >= 1")
+            raise ValueError(f"min_jump = {min_jump!r}: must be >= 1")
         if max_jump_initial < 1 or max_jump_until < 1:
-            raise ValueError("max_jump_initial and max_jump_until must be >= 1")
+            raise ValueError(f"max_jump_initial = {max_jump_initial!r}, max_jump_until = "
+                             f"{max_jump_until!r}: both must be >= 1")
         if decide_on not in ("total", "worst"):
             raise ValueError(f"decide_on = {decide_on!r}: must be 'total' (the sum of the "
                              "state, e.g. the worn volume) or 'worst' (every element)")

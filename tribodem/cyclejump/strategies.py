@@ -95,7 +95,8 @@ def _check_step_control(step_control: str, tol: float | None) -> None:
         raise ValueError(f"step_control = {step_control!r}: must be 'error' (jump length "
                          "capped by the local error estimate) or 'seed' (the seed's rule alone)")
     if tol is not None and not (math.isfinite(tol) and tol > 0):
-        raise ValueError("tol must be a finite number > 0 (relative local error per jump)")
+        raise ValueError(f"tol = {tol!r}: must be a finite number > 0 (relative local error "
+                         "per jump)")
 
 
 def _restore(template: State, arr: NDArray[np.float64]) -> State:
@@ -271,7 +272,7 @@ class ConstantJump(JumpStrategy):
     def __init__(self, jump_length: int = 20, step_control: str = "seed",
                  tol: float = 0.01) -> None:
         if jump_length < 1:
-            raise ValueError("jump_length must be >= 1")
+            raise ValueError(f"jump_length = {jump_length!r}: must be >= 1")
         _check_step_control(step_control, tol)
         self.jump_length = int(jump_length)
         self.step_control = step_control
@@ -457,7 +458,7 @@ class _GroupsJump(_SlopeRatioJump):
                  tol: float | None = None) -> None:
         if group_size < 2 or (self.even_groups and group_size % 2):
             kind = "an even number" if self.even_groups else "a whole number"
-            raise ValueError(f"group_size must be {kind} >= 2")
+            raise ValueError(f"group_size = {group_size!r}: must be {kind} >= 2")
         self.group_size = int(group_size)
         self.q_y = float(q_y)
         self.q_e = float(q_e)
@@ -630,7 +631,7 @@ class AdaptiveJump(JumpStrategy):
     ) -> None:
         _check_step_control(step_control, tol)
         if min_jump < 1:
-            raise ValueError("min_jump must be >= 1")
+            raise ValueError(f"min_jump = {min_jump!r}: must be >= 1")
         self.step_control = step_control
         self.tol = None if tol is None else float(tol)
         self.min_jump = int(min_jump)
@@ -639,14 +640,17 @@ class AdaptiveJump(JumpStrategy):
                              "'total' (the sum of the state, e.g. the worn volume)")
         self.decide_on = decide_on
         if degree < 1:
-            raise ValueError("degree must be >= 1")
+            raise ValueError(f"degree = {degree!r}: must be >= 1")
         if taylor_order not in (1, 2):
-            raise ValueError("taylor_order must be 1 (eq 4.15) or 2 (appendix III)")
+            raise ValueError(f"taylor_order = {taylor_order!r}: must be 1 (eq 4.15) or 2 "
+                             "(appendix III)")
         if foundation_cycles < degree + 1:
-            raise ValueError(f"foundation_cycles must be >= degree + 1 = {degree + 1}")
+            raise ValueError(f"foundation_cycles = {foundation_cycles!r}: must be >= degree + 1 "
+                             f"= {degree + 1}")
         self.degree = int(degree)
         if degree_late is not None and not 2 <= degree_late <= degree:
-            raise ValueError("degree_late must be None or in [2, degree]")
+            raise ValueError(f"degree_late = {degree_late!r}: must be None or in [2, degree = "
+                             f"{degree}]")
         self.degree_late = None if degree_late is None else int(degree_late)
         self.foundation_cycles = int(foundation_cycles)
         self.q_coef = float(q_coef)
@@ -661,7 +665,7 @@ class AdaptiveJump(JumpStrategy):
         self.refit_cycles = int(refit_cycles)
         self.moving_window = bool(moving_window)
         if window_fraction is not None and not 0.0 < window_fraction <= 1.0:
-            raise ValueError("window_fraction must be in (0, 1] or None")
+            raise ValueError(f"window_fraction = {window_fraction!r}: must be in (0, 1] or None")
         self.curvature_over_window = bool(curvature_over_window)
         self.window_fraction = None if window_fraction is None else float(window_fraction)
         self.taylor_order = int(taylor_order)
