@@ -204,3 +204,18 @@ def test_select_stages() -> None:
     assert [s.name for s in select(plan, ("swt", "s22"))] == ["s22", "swt"]
     with pytest.raises(ValueError, match="allowed: .*von_mises,s22,dfdi"):
         select(plan, ("shear", "wear"))
+
+
+def test_a_stage_that_cannot_run_is_refused_before_the_study_writes(tmp_path: Path) -> None:
+    """A window below 4 contact radii (here 2e-4 m for a contact radius of 131.5 um) is
+    refused for the first stage that would run it, before study.toml or any stage folder is
+    written; a stage its backend cannot serve (dfdi on the elastic half-space) is no
+    refusal, it is skipped later with its reason."""
+    from tribodem.fretting import study
+    from tribodem.io.config import ConfigError
+
+    out = tmp_path / "study"
+    data = {"contact": {"n": 32, "n_increments": 8, "window": 2e-4}}
+    with pytest.raises(ConfigError, match="contact.window"):
+        study(data, out, stages=("dfdi", "energy"))
+    assert not out.exists()

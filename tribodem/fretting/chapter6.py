@@ -33,7 +33,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from tribodem.fretting.case import WINDOW_RADII, FrettingCase, check_compatible
+from tribodem.fretting.case import WINDOW_RADII, FrettingCase, check_compatible, preflight
 from tribodem.fretting.config import (
     RESUME_MAY_CHANGE,
     FrettingConfig,
@@ -388,6 +388,8 @@ def run_study(cfg: FrettingConfig, out: Path, quick: bool = False, resume: bool 
             raise ConfigError(f"--resume: the config differs from the study in '{out}': "
                               f"{'; '.join(diffs)}; allowed: the study's values (and its "
                               f"--quick; {may_change_text(RESUME_MAY_CHANGE)})")
+    if not resume:  # a resumed stage keeps the grids it started with: run_stage checks it
+        check_stages(cfg, plan, out, quick)
     out.mkdir(parents=True, exist_ok=True)
     write_text(out / "study.toml", dump_toml(meta))
     rows: list[dict[str, Any]] = []
@@ -401,6 +403,39 @@ def run_study(cfg: FrettingConfig, out: Path, quick: bool = False, resume: bool 
     return write_study(cfg, out, rows, done, quick)
 
 
+def stage_run_config(cfg: FrettingConfig, st: Stage, out: Path,
+                     quick: bool) -> tuple[FrettingConfig, dict[str, Any]]:
+    """The config stage ``st`` runs with (:func:`stage_config`; ``quick``:
+    :func:`quick_stage`, its notes returned; the ccx backends share one job cache in
+    ``out/ccx_cache``)."""
+    scfg = stage_config(cfg, st)
+    notes: dict[str, Any] = {}
+    if quick:
+        try:
+            scfg, notes = quick_stage(scfg, st)
+        except ConfigError:  # no counterpart serves it either: the stage is skipped
+            pass
+    if scfg.fe.cache is None and runs_ccx(scfg.solver):
+        # the one-cycle stages run the same first-body job: run it once
+        scfg = scfg.model_copy(update={"fe": scfg.fe.model_copy(
+            update={"cache": str((out / "ccx_cache").resolve())})})
+    return scfg, notes
+
+
+def check_stages(cfg: FrettingConfig, plan: list[Stage], out: Path, quick: bool) -> None:
+    """Every stage checked before the study writes anything (:func:`preflight`:
+    ``ConfigError`` naming the field: the window, the memory its arrays need, height maps,
+    the jumping); a stage its backend cannot serve is left to :func:`run_stage`, which
+    skips it with the reason."""
+    for st in plan:
+        scfg, _ = stage_run_config(cfg, st, out, quick)
+        try:
+            check_compatible(scfg)
+        except ConfigError:
+            continue
+        preflight(scfg)
+
+
 def run_stage(cfg: FrettingConfig, st: Stage, out: Path, label: str, *, resume: bool,
               progress: bool, echo: Echo | None, quick: bool = False) -> dict[str, Any]:
     """One stage into ``out/<stage>/`` (kept when it finished before and ``resume``;
@@ -408,17 +443,7 @@ def run_stage(cfg: FrettingConfig, st: Stage, out: Path, label: str, *, resume: 
     :func:`quick_stage`): its row (:func:`row_of`, with ``skipped`` or ``stopped`` saying
     why)."""
     say = echo or (lambda s: None)
-    scfg = stage_config(cfg, st)
-    notes: dict[str, Any] = {}
-    if quick:
-        try:
-            scfg, notes = quick_stage(scfg, st)
-        except ConfigError:  # no counterpart serves it either: skipped below, with the reason
-            pass
-    if scfg.fe.cache is None and runs_ccx(scfg.solver):
-        # the one-cycle stages run the same first-body job: run it once
-        scfg = scfg.model_copy(update={"fe": scfg.fe.model_copy(
-            update={"cache": str((out / "ccx_cache").resolve())})})
+    scfg, notes = stage_run_config(cfg, st, out, quick)
     folder = out / st.name
     try:
         check_compatible(scfg)
