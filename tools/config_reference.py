@@ -51,28 +51,6 @@ EXACT_UNITS = {"rpm": "r/min"}
 #: used only while the field's ``Field(description=...)`` is empty. Move them into the
 #: models; an entry whose field has a description in the code is not used.
 MISSING: dict[str, str] = {
-    # fretting
-    "cycles": "cycles to run, simulated and jumped (a resume may raise it)",
-    "contact.geometry": "the first-body case: crossed cylinders, sphere on flat, cylinder "
-    "on flat (line contact), flat punch with a rounded edge, measured height maps "
-    "(docs/fretting.md 'Geometries')",
-    "contact.regime": "tangential problem: gross, q = mu p wherever in contact; "
-    "ciavarella-jaeger, partial slip after the loading and each reversal (Mindlin's "
-    "superposition; point contacts on the elastic half-space)",
-    "wear.criterion": "material evolution criterion: energy (eq 2.7), archard (eq 2.6), "
-    "s22, von_mises, shear (eq 6.9), dfdi (eqs 6.1-6.2), swt (eqs 6.3-6.8)",
-    "jump.strategy": "cycle-jumping strategy (none: every cycle is simulated); its "
-    "parameters in jump.params",
-    "jump.params": "keyword parameters of the strategy (the table below); an unknown key "
-    "is refused",
-    "debris.cor": "coefficient of restitution of the debris contacts (Hertz-Mindlin)",
-    "debris.friction": "sliding friction coefficient of the debris contacts",
-    "debris.rolling_friction": "rolling friction coefficient of the debris contacts "
-    "(constant torque)",
-    "debris.seed": "random seed of the debris placement",
-    "output.figures": "write the PNG figures (profiles, wear scar, wear per cycle)",
-    "output.vtk": "write the worn surfaces for ParaView (surface_upper.vtu, "
-    "surface_lower.vtu)",
     # braking
     "condition.load_kN": "brake load, kN (table 4; turned into the pad pressure by the "
     "pad area the table implies: 13 kN -> 0.33 MPa)",

@@ -82,7 +82,10 @@ class ContactConfig(StrictModel):
     (the resolved config shows what ran). A field of another geometry is refused.
     """
 
-    geometry: GeometryName = "crossed_cylinders"
+    geometry: GeometryName = Field(
+        "crossed_cylinders", description="the first-body case: crossed cylinders, sphere on "
+        "flat, cylinder on flat (line contact), flat punch with a rounded edge, measured "
+        "height maps (docs/fretting.md 'Geometries')")
     diameter: float | None = Field(
         None, gt=0, **physical(*DIAMETER_RANGE, "m", "crossed_cylinders: both cylinders' "
                                "diameter, m (shorthand for radius_upper = radius_lower = "
@@ -117,7 +120,10 @@ class ContactConfig(StrictModel):
         "window plus twice the amplitude at the window's spacing, and must fit in memory)"))
     n_increments: int = Field(48, ge=4, le=100_000,
                               description="increments per cycle (multiple of 4)")
-    regime: Literal["gross", "ciavarella-jaeger"] = "gross"
+    regime: Literal["gross", "ciavarella-jaeger"] = Field(
+        "gross", description="tangential problem: gross, q = mu p wherever in contact; "
+        "ciavarella-jaeger, partial slip after the loading and each reversal (Mindlin's "
+        "superposition)")
     n: int = Field(256, ge=16, le=2048, description="window points per side (even)")
     window: float | None = Field(None, gt=0, **physical(
         1e-8, 1.0, "m", "window side, m (None: 10 radii; it must hold 4 contact radii and "
@@ -208,7 +214,9 @@ class ContactConfig(StrictModel):
 class WearConfig(StrictModel):
     """Criterion and its parameters (SI)."""
 
-    criterion: CriterionName = "energy"
+    criterion: CriterionName = Field(
+        "energy", description="material evolution criterion: energy (eq 2.7), archard "
+        "(eq 2.6), s22, von_mises, shear (eq 6.9), dfdi (eqs 6.1-6.2), swt (eqs 6.3-6.8)")
     alpha: float = Field(ALPHA_SEED, ge=0, **physical(
         *WEAR_COEFFICIENT_RANGE, "m^3/J", "energy wear coefficient, m^3/J"))
     energy_share_upper: float = Field(
@@ -245,8 +253,12 @@ class JumpConfig(StrictModel):
     """Cycle-jumping: a strategy of Lu (2018) chapter 4 and its parameters, capped by the
     loop's geometry control (docs/fretting.md, "Jumping")."""
 
-    strategy: JumpName = "none"
-    params: dict[str, Any] = Field(default_factory=dict)
+    strategy: JumpName = Field(
+        "none", description="cycle-jumping strategy (none: every cycle is simulated); its "
+        "parameters in jump.params")
+    params: dict[str, Any] = Field(
+        default_factory=dict, description="keyword parameters of the strategy (the table "
+        "below); an unknown key is refused")
     geometry_tolerance: float = Field(
         GEOMETRY_TOLERANCE, ge=0, description="largest jumped depth increment / the "
         "contact's elastic approach (0: the strategy alone)")
@@ -262,7 +274,8 @@ class DebrisConfig(StrictModel):
     shares: tuple[float, float, float] = Field(
         (1 / 3, 1 / 3, 1 / 3), description="spherical, chunk, rubbing fractions")
     volume_correction: float = Field(1.0, gt=0, le=2, description="seed's 0.77 (optional)")
-    cor: float = Field(0.72, gt=0, le=1)
+    cor: float = Field(0.72, gt=0, le=1, description="coefficient of restitution of the "
+                       "debris contacts (Hertz-Mindlin)")
     friction: float = Field(0.6, ge=0, **physical(
         *FRICTION_RANGE, "", "sliding friction coefficient of the debris contacts"))
     rolling_friction: float = Field(0.001, ge=0, **physical(
@@ -273,14 +286,16 @@ class DebrisConfig(StrictModel):
     max_steps: int = Field(200_000, ge=100, description="DE steps per phase at most")
     ramp_steps: int = Field(10_000, ge=0, description="servo target ramp, steps")
     target_cap: float = Field(0.9, gt=0, lt=1, description="debris load <= cap x load")
-    seed: int = 0
+    seed: int = Field(0, description="random seed of the debris placement")
 
 
 class OutputConfig(StrictModel):
     """What is written besides results.csv / summary.json / config.toml (which always are)."""
 
-    figures: bool = True
-    vtk: bool = True
+    figures: bool = Field(True, description="write the PNG figures (profiles, wear scar, "
+                          "wear per cycle)")
+    vtk: bool = Field(True, description="write the worn surfaces for ParaView "
+                      "(surface_upper.vtu, surface_lower.vtu)")
     checkpoint_every: int = Field(
         1, ge=1, description="checkpoint.npz and results.csv rewritten every K simulated "
         "cycles at the most (and at the end)")
@@ -327,7 +342,8 @@ class FrettingConfig(PhysicalConfig):
     """``tribodem fretting run`` configuration (TOML tables contact, wear, jump, plastic, fe,
     debris, output)."""
 
-    cycles: int = Field(160, ge=1, le=10**7)
+    cycles: int = Field(160, ge=1, le=10**7, description="cycles to run, simulated and "
+                        "jumped (a resume may raise it)")
     solver: str = Field("elastic", description="first-body backend (tribodem.contact.BACKENDS)")
     config_version: int = Field(
         CONFIG_VERSION, ge=CONFIG_VERSION, le=CONFIG_VERSION, description="the config "
