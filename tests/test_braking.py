@@ -898,3 +898,24 @@ def test_fixed_distance_run_through_the_installed_command(tmp_path: Path) -> Non
     assert r.returncode == 3 and "disc was worn through" in r.stderr, r.stderr[-800:]
     assert "disc_height_m" in r.stderr and "Traceback" not in r.stderr
     assert json.loads((out / "summary.json").read_text())["status"] == "worn_through"
+
+
+def test_contact_after_run_in_counts_the_loaded_samples_past_the_first_third() -> None:
+    """``contact_after_run_in`` on a made-up series of 31 samples over 3 mm: the pad
+    applied at sample 3 (the first load, 3 us), open again at samples 12-14 and 20; past
+    the run-in (a third of the distance, 1 mm) lie samples 11..30 (20), 16 of them loaded;
+    a series never loaded has no first contact and a fraction of 0."""
+    from tribodem.braking.summary import contact_after_run_in
+
+    rows = []
+    for k in range(31):
+        loaded = k >= 3 and k not in (12, 13, 14, 20)
+        rows.append({"time_s": 1e-6 * k, "sliding_distance_m": 1e-4 * k,
+                     "interface_force_N": 5.0 if loaded else 0.0})
+    out = contact_after_run_in(rows)
+    assert out["first_contact_time_s"] == pytest.approx(3e-6)
+    assert out["contact_fraction_after_run_in_samples"] == 20
+    assert out["contact_fraction_after_run_in"] == pytest.approx(16 / 20)
+    none = contact_after_run_in([{**r, "interface_force_N": 0.0} for r in rows])
+    assert none["first_contact_time_s"] is None and none["contact_fraction_after_run_in"] == 0
+    assert contact_after_run_in(rows[:1])["contact_fraction_after_run_in"] is None

@@ -64,7 +64,8 @@ MEMBER_COLUMNS = (
     "status", "load_kN", "pressure_Pa", "speed_rpm", "sliding_speed_m_s",
     "simulated_time_s", "simulated_sliding_distance_m", "wear_depth_mean_m",
     "wear_depth_max_m", "wear_depth_mean_disc_m", "wear_rate_steady_m_per_m",
-    "steady_reached", "contact_fraction", "broken_bonds", "debris_particles",
+    "steady_reached", "contact_fraction", "contact_fraction_after_run_in", "broken_bonds",
+    "broken_bonds_tensile", "broken_bonds_shear", "debris_particles",
     "force_chains", "strong_force_chains", "mean_wall_pressure_ratio", "particles_initial",
     "particles_final")
 

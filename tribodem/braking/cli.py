@@ -31,6 +31,7 @@ SHOWN = ("status", "condition", "pressure_Pa", "sliding_speed_m_s", "simulated_t
          "broken_bonds", "debris_particles", "force_chains", "particles_initial",
          "particles_final", "mean_wall_pressure_ratio", "wear_rate_steady_m_per_m",
          "steady_reached", "run_in_distance_m", "run_in_depth_m", "contact_fraction",
+         "contact_fraction_after_run_in",
          "wall_time_s")
 
 

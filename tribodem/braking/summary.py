@@ -90,6 +90,25 @@ def _run_fields(setup: RunSetup, slid: float, t_sim: float) -> dict[str, Any]:
     }
 
 
+def contact_after_run_in(rows: list[dict[str, float]]) -> dict[str, Any]:
+    """The interface's contact measured on the samples (``rows``: the time series): the
+    time (s) of the first sample that carries load through the interface (the pad
+    applied), and the share of the samples after the run-in (sliding distance past a
+    third of the run's, the steady rule's window) at which it carries load
+    (``interface_force_N`` > 0), with their count; None where there is no such sample."""
+    dist = np.array([r["sliding_distance_m"] for r in rows])
+    load = np.array([r["interface_force_N"] for r in rows])
+    on = np.flatnonzero(load > 0.0)
+    late = dist > dist[-1] / 3.0 if dist.size else dist.astype(bool)
+    n = int(np.count_nonzero(late))
+    return {
+        "first_contact_time_s": float(rows[on[0]]["time_s"]) if on.size else None,
+        "contact_fraction_after_run_in": (float(np.count_nonzero(load[late] > 0.0)) / n
+                                          if n else None),
+        "contact_fraction_after_run_in_samples": n,
+    }
+
+
 def _rate_fields(loop: BrakingLoop) -> dict[str, Any]:
     """The wear rates (steady per distance m/m, second half in time m/s, run-in), the
     contact fraction, the ramps (s) and the extrapolated depth at 8 s (m)."""
@@ -123,6 +142,7 @@ def _rate_fields(loop: BrakingLoop) -> dict[str, Any]:
                                        "are in contact with a positive normal force, i.e. "
                                        "the interface carries load",
         "interface_load_ratio_mean": drive.contact[2] / looks,
+        **contact_after_run_in(rows),
         "ramp_s": setup.ramp_s,
         "speed_ramp_s": setup.speed_ramp_s,
         "wear_depth_mean_extrapolated_8s_m": h8,
