@@ -9,8 +9,9 @@ backends update the geometry once a cycle), window 0.364 mm, n 128 and 24 increm
 cycle for fe; the section also at n 256 and 48 increments, in gross slip and with the
 Ciavarella-Jaeger partial slip (``[contact] regime``), fe's own regime being Coulomb
 friction in the FE contact. The width is where the depth exceeds 5 % and 50 % of its
-maximum, interpolated linearly. The runs resume: ``--out`` keeps them (fe at h = a/4 is
-10-15 min on one core, ``--fine`` adds h = a/8, about an hour).
+maximum, interpolated linearly, against the finest fe mesh run. The runs resume: ``--out``
+keeps them (fe at h = a/4 is 10-15 min on one core, ``--fine`` adds h = a/8, about 35 min,
+and compares with it).
 
     .venv/bin/python benchmarks/line_vs_fe.py --out runs/line_vs_fe [--fine]
 """
@@ -85,7 +86,8 @@ def main() -> None:
                 (folder / "summary.json").read_text()).get("stopped"):
             run(data, folder, resume=(folder / "checkpoint.npz").exists())
         got[name] = profiles(folder)
-    ref = got.pop("fe_a4")
+    base = "fe_a8" if args.fine else "fe_a4"  # the reference: the finest fe mesh run
+    ref = got.pop(base)
     for name, prof in got.items():
         cells = []
         for body in ("upper", "lower"):
@@ -93,7 +95,7 @@ def main() -> None:
             cells.append(f"{body} depth {w.max() / wr.max() - 1:+.2%}, width "
                          f"{width(x, w, 0.05) / width(xr, wr, 0.05) - 1:+.2%} (5 %) "
                          f"{width(x, w, 0.5) / width(xr, wr, 0.5) - 1:+.2%} (50 %)")
-        print(f"{name} against fe_a4: " + "; ".join(cells))
+        print(f"{name} against {base}: " + "; ".join(cells))
 
 
 if __name__ == "__main__":
