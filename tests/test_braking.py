@@ -749,6 +749,8 @@ def test_default_cell_is_the_trend_study_cell_and_quick_one_junction() -> None:
     assert 11_000 < cell_particles(d) < 14_000
     q = resolve_config(quick=True)
     assert q.geometry.width_m == 144e-6 and q.geometry.roughness_first_mode == 1
+    # the default pad starts touching the disc, the quick one 50 nm above it, as before
+    assert d.geometry.clearance_m == 0.0 and q.geometry.clearance_m == 5e-8
     assert cell_particles(q) < cell_particles(d) / 20
     q16 = resolve_config({"geometry": {"roughness_first_mode": 16}}, quick=True)
     assert q16.geometry.roughness_first_mode == 1  # the preset's auto, not the file's 16
