@@ -359,6 +359,12 @@ class FirstBodySolver(ABC):
         stresses, plastic strain, timings), for summary.json; default: nothing."""
         return {}
 
+    def cycle_columns(self) -> dict[str, float]:
+        """Per-cycle numbers the backend measured over the cycle just solved, for the
+        ``results.csv`` row of that cycle (e.g. the elastic-plastic half-space's maximum
+        equivalent plastic strain and its depth per body); default: none."""
+        return {}
+
     def set_surfaces(self, upper: Recession, lower: Recession) -> None:
         """Give the (worn) surfaces the next increments see (recessions, m)."""
         self.upper, self.lower = upper, lower

@@ -1,49 +1,54 @@
-"""Elastic-plastic half-space backend on tamaas EPIC (DESIGN.md "The fretting FE-DE model").
+"""Elastic-plastic half-space backend with friction (DESIGN.md "The fretting FE-DE model").
 
-Model (Lu (2018) section 5.2: bilinear EN24T; replaces the Abaqus elastic-plastic FE phase):
+Model (Lu (2018) section 5.2: bilinear EN24T; replaces the Abaqus elastic-plastic FE
+phase), the semi-analytical method of Jacq, Nelias, Lormand and Girodin (J. Tribology 2002)
+as Gallego, Nelias and Jacq use it for fretting wear (J. Tribology 2006):
 
-* Two bodies of the *same* elastic-plastic material under the same normal pressure have the
-  same elastic-plastic response (a half-space's state depends only on its surface traction
-  history), so the normal problem is one EN24T half-space (E, nu, von Mises yield
-  ``sigma_y + h p``, ``p`` the cumulated plastic strain) pressed by a rigid surface equal to
-  *half* the summed recession. It is solved by :class:`tamaas.EPICSolver`
-  (:class:`tamaas.PolonskyKeerRey` around :class:`tamaas.Residual` with
-  :class:`tamaas.materials.IsotropicHardening`, :class:`DFSANECXXSolver`) on a coarse
-  ``volume_2d`` grid (``ep_n`` x ``ep_n`` points over ``ep_window_radii`` Hertz radii,
-  ``ep_nz`` layers down to ``ep_depth_radii`` radii), non-dimensionally (length: Hertz
-  radius a_H, stress: E / (1 - nu^2)).
-* Load-stepped (``load_steps`` equal steps) on the first loading. The per-cycle reload of
-  the persistent plastic state at full load on the worn geometry (:meth:`begin_cycle`,
-  ``reload_cycles=True``) is off by default: it ratchets in tamaas 2.9 (see there), so the
-  plastic state and the conformed surfaces are frozen after the first loading.
-* The permanent (plastic) surface displacement ``u_p`` (Mindlin displacement of C : eps_p) is
-  added to the recession of *both* bodies (upper: window frame, lower: lab frame at offset
-  0), so the elastic fine-grid increments of :class:`HalfSpaceSolver` (pressure, gross slip
-  or Ciavarella-Jaeger traction, energy) run on the plastically conformed surfaces: elastic
-  reloading of an elastic-plastic body whose plastic strain does not change.
-* Plastic strain and cumulated plastic strain are exposed on the subsurface grid
-  (:class:`PlasticSubsurfaceStress`) and, per load step, for the DFDI criterion
-  (:meth:`pop_plastic_steps`).
+* **Each body its own plastic state** (:class:`~tribodem.contact.plastic_halfspace.
+  PlasticHalfSpace`): the upper body on a ``ep_n`` x ``ep_n`` grid fixed in its own
+  (window) frame, the lower body on a track grid in the lab frame that covers the stroke
+  (``ep_n + 2 ceil(A / dx)`` points along x), ``ep_nz`` layers to ``ep_depth_radii``
+  Hertz radii; von Mises, linear isotropic hardening ``sigma_y + h p``.
+* **The full surface traction drives plasticity at every increment**: after the contact
+  solve of an increment (:class:`HalfSpaceSolver`: pressure p, and the tangential traction
+  of its slip regime, q = mu p in gross slip or the Ciavarella-Jaeger partial-slip traction),
+  the traction (q, p) on the upper body and (-q, p) on the lower one (plus the debris
+  pressure on both) is applied to each body as the increment from the last one (eq 1 of
+  :mod:`~tribodem.contact.plastic_halfspace`), at every sampled increment of the stroke and
+  at ``load_steps`` steps of the first loading; the plastic strain, the hardening (p) and the
+  residual stress and displacement are carried from increment to increment and cycle to
+  cycle (never reset by the loop).
+* **Coupling**: the residual (plastic) surface displacement of both bodies is added to the
+  summed recession (upper: window frame, lower: lab frame under the window), so each
+  contact solve sees the plastically conformed surfaces (Jacq et al.: h = h0 + u_e + u_r).
+  Staggered: increment k's pressure is solved on the residual displacement after
+  increment k - 1 (one plastic solve per body and increment; the lag is one increment of
+  the stroke, or one load step while loading).
+* **Outputs**: per load step and increment the plastic strain increment and the stress
+  (contact plus residual) for DFDI (:meth:`plastic_steps`, one :class:`PlasticStep` per
+  body); the subsurface stress is the elastic stress of the increment's tractions on the
+  window grid plus the residual stress of the plastic state after the increment
+  (interpolated from the plastic grid); per cycle the max equivalent plastic strain and its
+  depth per body and the cycle's largest increment of it (:meth:`cycle_columns`, the
+  ``results.csv`` columns), and in :meth:`report` a ``shakedown`` statement.
 
-Limits: tamaas EPIC is frictionless, so the plastic strain is that of the normal load (the
-shear traction's contribution to plastic flow is neglected); plasticity is computed at
-offset 0 only (the lower track away from the centre of the stroke stays elastic); residual
-stresses are not added to the subsurface stress (it is the elastic stress of the contact
-tractions on the conformed surfaces).
+Limits: small strains on the undeformed half-space (no geometric non-linearity, no pile-up
+geometry beyond the residual displacement); the plastic grid is periodic (images one grid
+length away); elastically similar bodies only (one material for both).
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar, cast
 
 import numpy as np
-import tamaas as tm
 from numpy.typing import NDArray
 
 from tribodem.contact.base import (
+    BODIES,
     Body,
     Capabilities,
     IncrementResult,
@@ -54,10 +59,11 @@ from tribodem.contact.geometry import Recession
 from tribodem.contact.halfspace import (
     HalfSpaceSolver,
     estimate_contact_radius,
-    model_fields,
-    set_model_fields,
+    max_shear,
+    von_mises,
 )
 from tribodem.contact.options import PlasticOptions, option_table
+from tribodem.contact.plastic_halfspace import PlasticHalfSpace, block_average
 from tribodem.io.config import ConfigError
 from tribodem.materials.en24t import EN24T
 
@@ -104,13 +110,6 @@ def bilinear_hardening(young: float, yield_strength: float, uts: float, uts_stra
     return young * et / (young - et)
 
 
-def _mandel_to_voigt(a: NDArray[np.float64]) -> NDArray[np.float64]:
-    """tamaas 2.9 (xx, yy, zz, xy, xz, yz; shear x sqrt 2) -> (xx, yy, zz, yz, xz, xy)."""
-    out = np.asarray(a, dtype=float)[..., [0, 1, 2, 5, 4, 3]].copy()
-    out[..., 3:] /= math.sqrt(2.0)
-    return out
-
-
 @dataclass
 class PlasticSubsurfaceStress(SubsurfaceStress):
     """:class:`SubsurfaceStress` plus the plastic state of the body on the same grid."""
@@ -123,9 +122,9 @@ class PlasticSubsurfaceStress(SubsurfaceStress):
 class PlasticStep:
     """One plastic load step on a [nz, nx, ny] grid under a body.
 
-    EPIC (``body`` None): one state shared by both bodies, on the coarse grid at offset 0
-    (x = y coordinates). A backend with a state per body (``fe``) sets ``body`` and ``y``:
-    the upper body's grid is in its own (window) frame, the lower body's in the lab frame.
+    ``body`` None: one state shared by both bodies, on a grid at offset 0 (x = y
+    coordinates). A backend with a state per body sets ``body`` and ``y``: the upper body's
+    grid is in its own (window) frame, the lower body's in the lab frame.
     """
 
     z: NDArray[np.float64]  #: depths below the body's surface, m, [nz]
@@ -138,36 +137,42 @@ class PlasticStep:
 
 
 class ElastoPlasticSolver(HalfSpaceSolver):
-    """Elastic-plastic first-body solver: EPIC at loading / cycle start, elastic increments.
+    """Elastic-plastic first-body solver with friction: the elastic half-space contact
+    solve of every increment, then both bodies' plastic states under its full traction.
 
     Takes every :class:`HalfSpaceSolver` argument plus: ``yield_strength`` Pa (680 MPa),
     ``hardening`` plastic modulus h Pa (None: :func:`bilinear_hardening` from ``uts`` Pa and
-    ``uts_strain``), ``ep_n`` coarse points per side (32), ``ep_nz`` layers (12),
-    ``ep_window_radii`` (5) and ``ep_depth_radii`` (2) Hertz radii, ``load_steps`` (4),
-    ``ep_tolerance`` (EPIC fixed point, 1e-6), ``ep_max_iter`` (300), ``reload_cycles``
-    (False), ``beyond_uts`` (only ``"line"``: the hardening line goes on past the UTS).
-    Both bodies must be of the same material.
+    ``uts_strain``), ``ep_n`` plastic grid points per side (32), ``ep_nz`` layers (12),
+    ``ep_window_radii`` (5) and ``ep_depth_radii`` (2) Hertz radii, ``load_steps`` (4, the
+    first loading), ``ep_tolerance`` (the plastic solve's, 1e-6), ``ep_max_iter`` (300),
+    ``amplitude`` (m: the lower body's track grid covers +-amplitude; None: no stroke
+    beyond the plastic window), ``shakedown_tolerance`` (a cycle whose largest increment of
+    the equivalent plastic strain is below it has shaken down), ``ep_iterations`` (4),
+    ``ep_coupling_tolerance`` (0.02) and ``ep_relaxation`` (0.5): the coupling of an
+    increment that yields (see :meth:`_coupled`), ``beyond_uts`` (only ``"line"``). Both
+    bodies must be of the same material.
     """
 
     name = "elastic-plastic"
     options: ClassVar[dict[str, type[BaseModel]]] = {"plastic": PlasticOptions}
-    capabilities = Capabilities(plastic=True, partial_slip=True, subsurface=True, debris=True,
-                                contacts=("point",))
+    capabilities = Capabilities(plastic=True, plastic_every_cycle=True, partial_slip=True,
+                                subsurface=True, debris=True, contacts=("point",))
 
     @classmethod
     def from_case(cls, case: ContactCase, options: Mapping[str, BaseModel] | None = None
                   ) -> Self:
-        """The solver on ``case`` with the ``[plastic]`` table's law and EP grid
-        (:class:`~tribodem.contact.options.PlasticOptions`; its defaults when left out).
-        ``ConfigError`` for ``plastic.beyond_uts = 'hold'``: tamaas's linear hardening goes
-        on past the UTS."""
+        """The solver on ``case`` with the ``[plastic]`` table's law and plastic grid
+        (:class:`~tribodem.contact.options.PlasticOptions`; its defaults when left out), the
+        lower body's track grid covering ``case.amplitude``. ``ConfigError`` for
+        ``plastic.beyond_uts = 'hold'``: tamaas's linear hardening goes on past the UTS."""
         plastic = option_table(options, "plastic", PlasticOptions)
         if plastic.beyond_uts != "line":
             raise ConfigError(
                 f"plastic.beyond_uts = {plastic.beyond_uts!r}: solver = {cls.name!r} "
                 "has linear hardening only (it goes on past the UTS); allowed: 'line', or "
                 "solver = 'fe' or 'fe3d' with [fe] material = 'elastic-plastic'")
-        return cls(case.upper, case.lower, **cls.case_keywords(case), **plastic.model_dump())
+        return cls(case.upper, case.lower, **cls.case_keywords(case),
+                   amplitude=case.amplitude, **plastic.model_dump())
 
     def __init__(
         self,
@@ -186,7 +191,11 @@ class ElastoPlasticSolver(HalfSpaceSolver):
         load_steps: int = 4,
         ep_tolerance: float = 1e-6,
         ep_max_iter: int = 300,
-        reload_cycles: bool = False,
+        amplitude: float | None = None,
+        shakedown_tolerance: float = 1e-4,
+        ep_iterations: int = 4,
+        ep_coupling_tolerance: float = 0.02,
+        ep_relaxation: float = 0.5,
         **kw: Any,
     ) -> None:
         self._ep_ready = False
@@ -194,7 +203,7 @@ class ElastoPlasticSolver(HalfSpaceSolver):
         if self.upper_material != self.lower_material:
             raise ValueError(
                 "upper_material and lower_material differ: the elastic-plastic solver needs "
-                "both bodies of the same material (same traction -> same plastic state)"
+                "both bodies of the same material"
             )
         if beyond_uts != "line":
             raise ValueError(f"beyond_uts = {beyond_uts!r} is not allowed: tamaas's linear "
@@ -216,216 +225,303 @@ class ElastoPlasticSolver(HalfSpaceSolver):
         self.ep_n, self.ep_nz = int(ep_n), int(ep_nz)
         self.load_steps, self.ep_max_iter = int(load_steps), int(ep_max_iter)
         self.ep_tolerance = check_positive("ep_tolerance", ep_tolerance)
-        #: re-solve EPIC at full load at every cycle start (off: ratchets in tamaas 2.9)
-        self.reload_cycles = bool(reload_cycles)
-        #: Hertz contact radius of the unworn surfaces, m (the EP length unit)
+        self.shakedown_tolerance = check_positive("shakedown_tolerance", shakedown_tolerance)
+        if int(ep_iterations) != ep_iterations or ep_iterations < 1:
+            raise ValueError(f"ep_iterations = {ep_iterations!r} is not allowed: must be an "
+                             "integer >= 1")
+        self.ep_iterations = int(ep_iterations)
+        self.ep_coupling_tolerance = check_positive("ep_coupling_tolerance",
+                                                    ep_coupling_tolerance)
+        self.ep_relaxation = check_positive("ep_relaxation", ep_relaxation)
+        if self.ep_relaxation > 1.0:
+            raise ValueError(f"ep_relaxation = {ep_relaxation!r} is not allowed: must be in "
+                             "(0, 1]")
+        self.amplitude = 0.0 if amplitude is None else check_positive("amplitude", amplitude)
+        #: Hertz contact radius of the unworn surfaces, m (the plastic grid's length unit)
         self.a_hertz = estimate_contact_radius(self.upper, self.lower, self.load, self.modulus)
-        self.ep_window = check_positive("ep_window_radii", ep_window_radii) * self.a_hertz
+        # the plastic grid's spacing: a whole number of window cells (the tractions are
+        # averaged onto it cell by cell, exactly when every plastic cell holds k x k of them)
+        want = check_positive("ep_window_radii", ep_window_radii) * self.a_hertz / self.ep_n
+        self._ep_dx = max(1, round(want / self.dx)) * self.dx
+        #: side of the upper body's plastic grid, m (``ep_window_radii`` Hertz radii, to a
+        #: whole number of window cells per plastic cell)
+        self.ep_window = self._ep_dx * self.ep_n
         self.ep_depth = check_positive("ep_depth_radii", ep_depth_radii) * self.a_hertz
         if self.ep_window > self.window:
             raise ValueError(
-                f"ep_window_radii = {ep_window_radii!r} gives an EP window of "
+                f"ep_window_radii = {ep_window_radii!r} gives a plastic window of "
                 f"{self.ep_window:.4g} m, larger than the solver window {self.window:.4g} m"
             )
-        #: single-body plane-strain modulus E / (1 - nu^2), Pa (the EP stress unit)
-        self.ep_modulus = mat.young / (1.0 - mat.poisson**2)
+        #: lower track grid: points beyond the window on each side along x
+        self.ep_pad = int(math.ceil(self.amplitude / self.ep_dx - 1e-9))
         self._ep_ready = True
         self.reset()
 
-    # -- coarse EP model -------------------------------------------------------------
+    # -- plastic grids -----------------------------------------------------------------
     @property
     def ep_dx(self) -> float:
-        """Coarse EP grid spacing, m."""
-        return self.ep_window / self.ep_n
+        """Plastic grid spacing, m (a whole number of window cells)."""
+        return self._ep_dx
 
     @property
     def ep_coords(self) -> NDArray[np.float64]:
-        """Coarse EP grid x (= y) coordinates, m (lab frame at offset 0)."""
+        """Plastic grid x (= y) coordinates of the upper body, m (window frame)."""
         return ((np.arange(self.ep_n) - self.ep_n // 2) * self.ep_dx).astype(np.float64,
                                                                                 copy=False)
 
     @property
     def ep_z(self) -> NDArray[np.float64]:
-        """Coarse EP grid depths, m."""
+        """Plastic grid depths, m."""
         return np.linspace(0.0, self.ep_depth, self.ep_nz)
+
+    def _body_grid(self, body: str) -> PlasticHalfSpace:
+        mat = self.upper_material
+        nx = self.ep_n + (2 * self.ep_pad if body == "lower" else 0)
+        x0 = -(self.ep_n // 2 + (self.ep_pad if body == "lower" else 0)) * self.ep_dx
+        return PlasticHalfSpace(
+            nx, self.ep_n, self.ep_nz, self.ep_dx, self.ep_depth, x0,
+            -(self.ep_n // 2) * self.ep_dx, mat.young, mat.poisson, self.yield_strength,
+            self.hardening, self.a_hertz, self.ep_tolerance, self.ep_max_iter)
 
     def reset(self) -> None:
         super().reset()
         if not getattr(self, "_ep_ready", False):
             return
-        a = self.a_hertz
-        lx = self.ep_window / a
-        self._ep = tm.ModelFactory.createModel(
-            tm.model_type.volume_2d, [self.ep_depth / a, lx, lx],
-            [self.ep_nz, self.ep_n, self.ep_n])
-        mat = self.upper_material
-        self._ep.E = mat.young / self.ep_modulus
-        self._ep.nu = mat.poisson
-        self._ep_mat = tm.materials.IsotropicHardening(
-            self._ep, sigma_y=self.yield_strength / self.ep_modulus,
-            hardening=self.hardening / self.ep_modulus)
-        self._ep_res = tm.Residual(self._ep, self._ep_mat)
-        import tamaas.nonlinear_solvers  # here, not with the module: see _grid
-
-        self._ep_nl = tamaas.nonlinear_solvers.DFSANECXXSolver(self._ep_res)
-        # separate model for the Mindlin post-processing: registering or applying volume
-        # operators on the EPIC model itself corrupts its next solve (measured: ratcheting)
-        self._aux = tm.ModelFactory.createModel(
-            tm.model_type.volume_2d, [self.ep_depth / a, lx, lx],
-            [self.ep_nz, self.ep_n, self.ep_n])
-        self._aux.E, self._aux.nu = self._ep.E, self._ep.nu
-        tm.ModelFactory.registerVolumeOperators(self._aux)
-        # one contact solver and one EPIC for the whole run: EPIC keeps the residual
-        # (plastic) displacement between solves; the surface is updated in place
-        self._ep_surface = np.zeros((self.ep_n, self.ep_n))
-        self._ep_contact = tm.PolonskyKeerRey(self._ep, self._ep_surface, 1e-12)
-        self._ep_contact.max_iter = 10000
-        self._epic = tm.EPICSolver(self._ep_contact, self._ep_nl, self.ep_tolerance, 0.3)
-        self._epic.max_iter = self.ep_max_iter
-        self._ep_loaded = False
-        self._plastic_map: RegularGridInterpolator | None = None
+        #: the plastic state of each body
+        self.bodies: dict[str, PlasticHalfSpace] = {b: self._body_grid(b) for b in BODIES}
+        self._loaded = False
         self._steps: list[PlasticStep] = []
-        #: EPIC pressure of the last elastic-plastic solve, Pa, [ep_n, ep_n]
-        self.ep_pressure: NDArray[np.float64] | None = None
-        #: plastic surface displacement of each body, m, [ep_n, ep_n]
-        self.plastic_displacement: NDArray[np.float64] | None = None
+        self._maps: dict[str, RegularGridInterpolator | None] = {b: None for b in BODIES}
+        self._cycle_rows: list[dict[str, Any]] = []
+        self._cycle_start: dict[str, NDArray[np.float64]] | None = None
+        self._cycle_increments = 0
+        #: coupling passes of every increment and load step solved (:meth:`_coupled`)
+        self.coupling_passes: list[int] = []
 
+    # -- resume ------------------------------------------------------------------------
     def state_dict(self) -> dict[str, Any]:
-        """:meth:`HalfSpaceSolver.state_dict` plus the plastic state: the EPIC model's fields
-        (plastic strain, cumulated plastic strain, stress, ...), the EP surface, the plastic
-        surface displacement and the load steps not yet collected.
-
-        EPIC's own residual displacement is not reachable from Python, so a run with
-        ``reload_cycles`` (EPIC re-solved every cycle) cannot be checkpointed
-        (``NotImplementedError``); without it EPIC runs only at the first loading.
-        """
-        if self.reload_cycles and self._ep_loaded:
-            raise NotImplementedError("reload_cycles = True: EPIC's internal residual "
-                                      "displacement cannot be saved; no checkpoint")
+        """:meth:`HalfSpaceSolver.state_dict` plus both bodies' plastic states, the steps not
+        yet collected and the per-cycle records."""
         return {
             **super().state_dict(),
-            "ep_loaded": self._ep_loaded,
-            "ep": model_fields(self._ep),
-            "aux": model_fields(self._aux),
-            "ep_surface": self._ep_surface.copy(),
-            "ep_pressure": None if self.ep_pressure is None else self.ep_pressure.copy(),
-            "plastic_displacement": (None if self.plastic_displacement is None
-                                     else self.plastic_displacement.copy()),
+            "ep_loaded": self._loaded,
+            "ep_bodies": {b: s.state_dict() for b, s in self.bodies.items()},
             "steps": list(self._steps),
+            "cycle_rows": [dict(r) for r in self._cycle_rows],
+            "cycle_start": (None if self._cycle_start is None
+                            else {b: v.copy() for b, v in self._cycle_start.items()}),
+            "cycle_increments": self._cycle_increments,
         }
 
     def load_state_dict(self, state: dict[str, Any]) -> None:
         """Restore :meth:`state_dict` (same grids)."""
         super().load_state_dict(state)
-        set_model_fields(self._ep, state["ep"])
-        set_model_fields(self._aux, state["aux"])
-        self._ep_surface[...] = state["ep_surface"]
-        self._ep_loaded = bool(state["ep_loaded"])
+        for b, s in self.bodies.items():
+            s.load_state_dict(state["ep_bodies"][b])
+        self._loaded = bool(state["ep_loaded"])
         self._steps = list(state["steps"])
-        pe, up = state["ep_pressure"], state["plastic_displacement"]
-        self.ep_pressure = None if pe is None else np.array(pe, dtype=float)
-        self.plastic_displacement = None if up is None else np.array(up, dtype=float)
-        self._plastic_map = None
-        if self.plastic_displacement is not None:
-            c = self.ep_coords
-            self._plastic_map = _grid((c, c), self.plastic_displacement,
-                                      bounds_error=False, fill_value=0.0)
+        self._cycle_rows = [dict(r) for r in state["cycle_rows"]]
+        cs = state["cycle_start"]
+        self._cycle_start = None if cs is None else {b: np.array(v) for b, v in cs.items()}
+        self._cycle_increments = int(state["cycle_increments"])
+        for b in BODIES:
+            self._update_map(b)
 
-    def begin_cycle(self) -> None:
-        """Elastic-plastic normal solve at offset 0 on the current (worn) surfaces.
-
-        First call after :meth:`reset`: ``load_steps`` load steps from zero. Later calls do
-        nothing unless ``reload_cycles``: then one reload at full load from the persistent
-        plastic state on the worn geometry (off by default: with tamaas 2.9 the reload of an
-        unchanged geometry ratchets, peak 1579 -> 1932 -> 2114 MPa, p 0.0063 -> 0.0108 ->
-        0.0139, instead of shaking down). Updates the plastic surface displacement.
-        """
-        if self._ep_loaded and not self.reload_cycles:
-            return
-        a, es = self.a_hertz, self.ep_modulus
-        c = self.ep_coords
-        xc, yc = np.meshgrid(c, c, indexing="ij")
-        g = np.asarray(self.upper(xc, yc) + self.lower(xc, yc), dtype=float)
-        half = 0.5 * (g - g.min()) / a
-        self._ep_surface[...] = -half
-        epic = self._epic
-        loads = ([self.load] if self._ep_loaded else
-                 [self.load * (k + 1) / self.load_steps for k in range(self.load_steps)])
-        area = (self.ep_window / a) ** 2
-        for load in loads:
-            before = np.array(self._ep["cumulated_plastic_strain"], dtype=float)
-            epic.solve(load / (area * a * a * es))
-            after = np.array(self._ep["cumulated_plastic_strain"], dtype=float)
-            self._steps.append(PlasticStep(
-                z=self.ep_z, x=c.copy(), dp=np.maximum(after - before, 0.0),
-                stress=_mandel_to_voigt(self._ep["stress"]) * es, load=float(load)))
-        self._ep_loaded = True
-        p = np.array(self._ep.traction, dtype=float)[..., 2]
-        if np.any(p[0] > 0) or np.any(p[-1] > 0) or np.any(p[:, 0] > 0) or np.any(p[:, -1] > 0):
-            raise ValueError(
-                f"the elastic-plastic contact touches the EP window edge ({self.ep_window:.4g} m):"
-                " increase ep_window_radii"
-            )
-        self.ep_pressure = p * es
-        # plastic surface displacement: Mindlin displacement of the plastic eigenstress
-        # C : eps_p (= total minus elastic displacement of p, checked; robust over steps)
-        eps_p = np.array(self._ep["plastic_strain"], dtype=float)
-        eig = np.zeros_like(eps_p)
-        self._aux.operators["hooke"](eps_p, eig)
-        disp = np.zeros(self._aux.displacement.shape)
-        self._aux.operators["mindlin"](eig, disp)
-        up = disp[0, ..., 2]
-        border = np.concatenate([up[0], up[-1], up[:, 0], up[:, -1]]).mean()
-        up = (up - border) * a
-        self.plastic_displacement = up
-        self._plastic_map = _grid((c, c), up, bounds_error=False, fill_value=0.0)
+    # -- the increment -----------------------------------------------------------------
+    def _update_map(self, body: str, u: NDArray[np.float64] | None = None) -> None:
+        s = self.bodies[body]
+        u = s.residual_displacement if u is None else u
+        self._maps[body] = (None if not np.any(u) else
+                            _grid((s.x, s.y), u, bounds_error=False, fill_value=0.0))
 
     def gap(self, offset: float) -> NDArray[np.float64]:
-        """Summed recession plus both bodies' plastic surface displacement, m, [n, n]."""
+        """Summed recession plus both bodies' residual (plastic) surface displacement, m."""
         g = super().gap(offset)
-        if self._plastic_map is None:
-            return g
         cw = self.coords
         xw, yw = np.meshgrid(cw, cw, indexing="ij")
-        up = self._plastic_map(np.stack([xw, yw], -1))
-        lo = self._plastic_map(np.stack([xw + offset, yw], -1))
-        return g + up + lo
+        up, lo = self._maps["upper"], self._maps["lower"]
+        if up is not None:
+            g = g + up(np.stack([xw, yw], -1))
+        if lo is not None:
+            g = g + lo(np.stack([xw + offset, yw], -1))
+        return g
+
+    def _apply(self, pressure: NDArray[np.float64], traction: NDArray[np.float64],
+               offset: float, load: float) -> bool:
+        """Apply the window's pressure and shear traction on the upper body (Pa) to both
+        bodies' plastic grids (the lower body: -traction, at lab x = window x + offset);
+        whether either body yielded."""
+        yielded = False
+        p = pressure + self.debris_pressure
+        t = np.concatenate([traction, p[..., None]], axis=-1)
+        c0 = float(self.coords[0])
+        for body, tt, shift in (("upper", t, 0.0), ("lower", t * np.array([-1.0, -1.0, 1.0]),
+                                                    offset)):
+            s = self.bodies[body]
+            on = block_average(tt, c0 + shift, self.dx, float(s.x[0]), s.dx, s.nx, c0,
+                               float(s.y[0]), s.ny)
+            lost = abs(float(on[..., 2].sum()) * s.dx**2 - float(p.sum()) * self.dx**2)
+            if lost > 1e-6 * max(load, 1e-300):
+                raise ValueError(
+                    f"the contact at offset {offset:.4g} m reaches beyond the {body} body's "
+                    f"plastic grid ({s.nx * s.dx:.4g} x {s.ny * s.dx:.4g} m): increase "
+                    "ep_window_radii (or give the stroke's amplitude)")
+            dp = s.load(on)
+            if dp.max() > 0.0:
+                self._steps.append(PlasticStep(z=s.z, x=s.x, y=s.y, dp=dp, stress=s.stress,
+                                               load=float(load), body=body))
+                self._update_map(body)
+                yielded = True
+        return yielded
+
+    def _coupled(self, contact: Callable[[], tuple[Any, NDArray[np.float64],
+                                                   NDArray[np.float64]]],
+                 offset: float, load: float) -> Any:
+        """One increment with the contact and the plastic states coupled (Jacq et al.'s
+        loop): ``contact()`` solves the contact on the current residual displacements and
+        returns (its result, pressure Pa, shear traction Pa); the tractions are applied to
+        both bodies. When that yields, the increment is redone from the state before it on
+        the residual displacement relaxed by ``ep_relaxation`` (u = u_old + w (u_new -
+        u_old)) until the peak change of the pressure between two passes is below
+        ``ep_coupling_tolerance`` x the peak pressure, ``ep_iterations`` passes at most;
+        the last pass is kept. Returns the last ``contact()`` result."""
+        snap = {b: s.state_dict() for b, s in self.bodies.items()}
+        n_steps = len(self._steps)
+        u_old = {b: s.residual_displacement.copy() for b, s in self.bodies.items()}
+        p_prev: NDArray[np.float64] | None = None
+        out: Any = None
+        for it in range(self.ep_iterations):
+            out, p, t = contact()
+            if p_prev is not None and (np.abs(p - p_prev).max()
+                                       <= self.ep_coupling_tolerance * p.max()):
+                it = self.ep_iterations - 1  # converged: this pass is the last
+            if not self._apply(p, t, offset, load) or it == self.ep_iterations - 1:
+                break
+            p_prev = p
+            w = self.ep_relaxation
+            u_new = {b: s.residual_displacement.copy() for b, s in self.bodies.items()}
+            for b, s in self.bodies.items():
+                s.load_state_dict(snap[b])
+                u_old[b] = u_old[b] + w * (u_new[b] - u_old[b])
+                self._update_map(b, u_old[b])
+            del self._steps[n_steps:]
+        self.coupling_passes.append(it + 1)
+        return out
+
+    def _first_loading(self, offset: float) -> None:
+        """The first ``load_steps - 1`` steps of the first loading (the last is the first
+        increment's own solve): frictionless normal solves at fractions of the load."""
+        for k in range(1, self.load_steps):
+            load = self.solid_load * k / self.load_steps
+
+            def normal(load: float = load) -> tuple[None, NDArray[np.float64],
+                                                    NDArray[np.float64]]:
+                p, _ = self._normal(self.gap(offset) + self._debris_u, load)
+                return None, p, np.zeros((*p.shape, 2))
+
+            self._coupled(normal, offset, load)
+        self._loaded = True
+
+    def begin_cycle(self) -> None:
+        """Close the previous cycle's record (:meth:`cycle_columns`) and start a new one."""
+        if self._cycle_start is not None and self._cycle_increments:
+            self._cycle_rows.append(self.cycle_columns())
+        self._cycle_start = {b: s.cumulated_plastic_strain for b, s in self.bodies.items()}
+        self._cycle_increments = 0
 
     def solve_increment(self, offset: float) -> IncrementResult:
-        if not self._ep_loaded:
-            self.begin_cycle()
-        return super().solve_increment(offset)
+        """:meth:`HalfSpaceSolver.solve_increment` on the plastically conformed surfaces,
+        then its full traction applied to both bodies' plastic states (the first call
+        loads in ``load_steps`` steps)."""
+        if self._cycle_start is None:
+            self._cycle_start = {b: s.cumulated_plastic_strain for b, s in self.bodies.items()}
+        if not self._loaded:
+            self._first_loading(float(offset))
+        before = HalfSpaceSolver.state_dict(self)
+
+        def contact() -> tuple[IncrementResult, NDArray[np.float64], NDArray[np.float64]]:
+            HalfSpaceSolver.load_state_dict(self, before)
+            res = HalfSpaceSolver.solve_increment(self, offset)
+            return res, res.pressure, res.traction
+
+        res = self._coupled(contact, float(offset), self.solid_load)
+        self._cycle_increments += 1
+        return cast("IncrementResult", res)
 
     def plastic_steps(self) -> list[PlasticStep]:
-        """EPIC load steps since the last call (for DFDI, eq 6.1); clears the list."""
+        """Plastic load steps and increments since the last call, one per body that yielded
+        (for DFDI, eq 6.1); clears the list."""
         steps, self._steps = self._steps, []
         return steps
 
     @property
     def plastic_depth(self) -> float:
-        """Depth of the EP grid, m (``ep_depth_radii`` Hertz radii)."""
+        """Depth of the plastic grid, m (``ep_depth_radii`` Hertz radii)."""
         return self.ep_depth
+
+    # -- reports -----------------------------------------------------------------------
+    def cycle_columns(self) -> dict[str, float]:
+        """The cycle so far (since :meth:`begin_cycle`), per body: ``max_peeq_{body}`` (the
+        largest equivalent plastic strain p, -), ``max_peeq_depth_{body}_m`` (its depth, m)
+        and ``peeq_increment_{body}`` (the largest increase of p over the cycle, -)."""
+        row: dict[str, float] = {}
+        for b, s in self.bodies.items():
+            pmax, depth, _ = s.peak()
+            start = (self._cycle_start or {}).get(b)
+            cum = s.cumulated_plastic_strain
+            inc = float((cum - start).max()) if start is not None else float(cum.max())
+            row |= {f"max_peeq_{b}": pmax, f"max_peeq_depth_{b}_m": depth,
+                    f"peeq_increment_{b}": max(inc, 0.0)}
+        return row
+
+    def shakedown(self, rows: list[dict[str, Any]]) -> dict[str, Any]:
+        """Shakedown statement of the cycle records ``rows``: the first cycle after the
+        first whose largest increment of p (both bodies) is below ``shakedown_tolerance``,
+        or that none is, with the last cycle's increment."""
+        tol = self.shakedown_tolerance
+        incs = [max(r["peeq_increment_upper"], r["peeq_increment_lower"]) for r in rows]
+        for k, v in enumerate(incs):
+            if k >= 1 and v < tol:
+                return {"reached": True, "cycle": k + 1, "peeq_increment": v,
+                        "tolerance": tol}
+        return {"reached": False, "cycles": len(incs),
+                "last_peeq_increment": incs[-1] if incs else None, "tolerance": tol}
+
+    def report(self) -> dict[str, Any]:
+        """Per cycle :meth:`cycle_columns` (``cycles``, the open cycle included), and the
+        ``shakedown`` statement (:meth:`shakedown`)."""
+        rows = list(self._cycle_rows)
+        if self._cycle_increments:
+            rows.append(self.cycle_columns())
+        return {"cycles": rows, "shakedown": self.shakedown(rows),
+                "plastic_grid": {"dx_m": self.ep_dx, "nz": self.ep_nz,
+                                 "depth_m": self.ep_depth,
+                                 "lower_nx": self.bodies["lower"].nx}}
+
+    # -- fields ------------------------------------------------------------------------
+    def _on_window(self, body: Body, values: NDArray[np.float64], offset: float,
+                   z: NDArray[np.float64]) -> NDArray[np.float64]:
+        """A [nz_ep, nx, ny, ...] field of ``body``'s plastic grid on the window at ``offset``
+        (m) and depths ``z`` (m) [len(z), n, n, ...] (zero outside the grid)."""
+        s = self.bodies[body]
+        cw = self.coords
+        shift = offset if body == "lower" else 0.0
+        zz, xx, yy = np.meshgrid(z, cw + shift, cw, indexing="ij")
+        pts = np.stack([zz, xx, yy], -1)
+        v = np.asarray(values, dtype=float)
+        if v.ndim == 3:
+            return _grid((s.z, s.x, s.y), v, bounds_error=False, fill_value=0.0)(pts)
+        return np.stack([_grid((s.z, s.x, s.y), v[..., k], bounds_error=False,
+                               fill_value=0.0)(pts) for k in range(v.shape[-1])], -1)
 
     def plastic_fields(
         self, body: Body, offset: float, z: NDArray[np.float64]
     ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """(plastic strain [nz, n, n, 6], cumulated plastic strain [nz, n, n]) of ``body`` on
-        the window at ``offset`` (m) and depths ``z`` (m); zero outside the EP grid."""
-        n = self.n
-        if not self._ep_loaded:
-            return np.zeros((len(z), n, n, 6)), np.zeros((len(z), n, n))
-        c = self.ep_coords
-        cw = self.coords
-        shift = offset if body == "lower" else 0.0
-        zz, xx, yy = np.meshgrid(z, cw + shift, cw, indexing="ij")
-        pts = np.stack([zz, xx, yy], -1)
-        cum = _grid(
-            (self.ep_z, c, c), np.array(self._ep["cumulated_plastic_strain"], dtype=float),
-            bounds_error=False, fill_value=0.0)(pts)
-        eps = _mandel_to_voigt(self._ep["plastic_strain"])
-        tens = np.stack([_grid((self.ep_z, c, c), eps[..., k], bounds_error=False,
-                               fill_value=0.0)(pts) for k in range(6)], -1)
-        return tens, cum
+        the window at ``offset`` (m) and depths ``z`` (m); zero outside the plastic grid."""
+        s = self.bodies[body]
+        return (self._on_window(body, s.plastic_strain, offset, z),
+                self._on_window(body, s.cumulated_plastic_strain, offset, z))
 
     def subsurface_stress(
         self,
@@ -434,9 +530,15 @@ class ElastoPlasticSolver(HalfSpaceSolver):
         depth: float | None = None,
         nz: int = 33,
     ) -> PlasticSubsurfaceStress:
-        """Elastic stress of the increment's tractions plus the plastic state (same grid)."""
+        """The elastic stress of the increment's tractions on the window grid plus the
+        residual stress of ``body``'s plastic state now (after the last solved increment),
+        and the plastic state, on the same grid."""
         st = super().subsurface_stress(result, body, depth=depth, nz=nz)
+        s = self.bodies[body]
+        stress = st.stress
+        if s.cumulated_plastic_strain.max() > 0.0:
+            stress = stress + self._on_window(body, s.residual_stress, result.offset, st.z)
         tens, cum = self.plastic_fields(body, result.offset, st.z)
         return PlasticSubsurfaceStress(
-            body=st.body, z=st.z, x=st.x, y=st.y, stress=st.stress, von_mises=st.von_mises,
-            tresca=st.tresca, plastic_strain=tens, cumulated_plastic_strain=cum)
+            body=st.body, z=st.z, x=st.x, y=st.y, stress=stress, von_mises=von_mises(stress),
+            tresca=max_shear(stress), plastic_strain=tens, cumulated_plastic_strain=cum)

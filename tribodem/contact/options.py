@@ -35,7 +35,7 @@ class ElasticOptions(StrictModel):
 
 
 class PlasticOptions(StrictModel):
-    """The plastic law of ``solver = "elastic-plastic"`` (tamaas EPIC; its ``ep_*`` grid) and
+    """The plastic law of ``solver = "elastic-plastic"`` (its ``ep_*`` plastic grid) and
     of the ccx backends' ``[fe] material = "elastic-plastic"``: bilinear EN24T (seed table
     5.1), one law for every backend."""
 
@@ -56,7 +56,18 @@ class PlasticOptions(StrictModel):
     ep_window_radii: float = Field(5.0, gt=0, description="EP window, Hertz radii")
     ep_depth_radii: float = Field(2.0, gt=0, description="EP depth, Hertz radii")
     load_steps: int = Field(4, ge=1, le=100, description="first-loading steps")
-    ep_tolerance: float = Field(1e-6, gt=0, lt=0.1, description="EPIC tolerance")
+    ep_tolerance: float = Field(1e-6, gt=0, lt=0.1,
+                                description="plastic solve tolerance (elastic-plastic)")
+    ep_iterations: int = Field(4, ge=1, le=100, description="contact-plasticity passes "
+                               "of an increment that yields, at most (elastic-plastic)")
+    ep_coupling_tolerance: float = Field(
+        0.02, gt=0, lt=1, description="coupling converged: peak pressure change between "
+        "passes below this share of the peak pressure (elastic-plastic)")
+    ep_relaxation: float = Field(0.5, gt=0, le=1, description="relaxation of the residual "
+                                 "displacement between passes (elastic-plastic)")
+    shakedown_tolerance: float = Field(
+        1e-4, gt=0, lt=1, description="shakedown: a cycle's largest increase of the "
+        "equivalent plastic strain below this (elastic-plastic)")
 
 
 def option_table(options: Mapping[str, BaseModel | Mapping[str, Any]] | None, table: str,

@@ -56,6 +56,16 @@ RESULT_COLUMNS = (
     "max_traction_Pa",
     "contact_area_m2",
 )
+#: Extra columns when the first body measures its plastic state per cycle
+#: (:meth:`~tribodem.contact.base.FirstBodySolver.cycle_columns`: ``elastic-plastic``).
+PLASTIC_COLUMNS = (
+    "max_peeq_upper",
+    "max_peeq_depth_upper_m",
+    "peeq_increment_upper",
+    "max_peeq_lower",
+    "max_peeq_depth_lower_m",
+    "peeq_increment_lower",
+)
 #: Extra columns when the debris third body is on (Lu (2018) sections 3.2.6-3.2.7).
 DEBRIS_COLUMNS = (
     "debris_particles",
@@ -351,7 +361,7 @@ class FrettingLoop:
                       "debris_load_fraction": float(self.solver.debris_load) / self.solver.load,
                       "max_pressure_with_debris_Pa": self._pmax_debris,
                       "load_balance_error": self._balance}
-        return {**per, **extra,
+        return {**per, **self.solver.cycle_columns(), **extra,
                 "criterion": self.criterion.info()}  # this cycle's diagnostics (criterion.csv)
 
     def _solve_pass(self) -> tuple[NDArray[np.float64], NDArray[np.float64], dict[str, float]]:

@@ -10,7 +10,12 @@ from typing import Any
 
 import numpy as np
 
-from tribodem.fretting.loop import DEBRIS_COLUMNS, RESULT_COLUMNS, FrettingHistory
+from tribodem.fretting.loop import (
+    DEBRIS_COLUMNS,
+    PLASTIC_COLUMNS,
+    RESULT_COLUMNS,
+    FrettingHistory,
+)
 from tribodem.io.config import ConfigError
 from tribodem.io.results import atomic_write, write_csv, write_figure, write_json
 
@@ -25,6 +30,8 @@ def write_rows(hist: FrettingHistory, out: Path) -> Path:
     reports per-cycle diagnostics (e.g. the largest DFDI or Miner sum), ``out/criterion.csv``
     with one row per simulated cycle (both rewritten atomically)."""
     cols = RESULT_COLUMNS + (DEBRIS_COLUMNS if hist.debris is not None else ())
+    if any(PLASTIC_COLUMNS[0] in r for r in hist.rows):  # the first body's plastic state
+        cols = cols + PLASTIC_COLUMNS
     info = [(r["cycle"], r["criterion"]) for r in hist.rows
             if not r.get("jumped") and r.get("criterion")]
     if info:
