@@ -92,8 +92,8 @@ class GeometryCfg(StrictModel):
         "times the modes has the same asperities")
     clearance_m: float = Field(0.0, ge=0, **physical(
         0.0, 1e-2, "m", "gap between the pad's lowest and the disc's highest point at the "
-        "start, m; 0 = touching (the absorbing backing lets the pad descend at most at "
-        "p / (rho c_p), ~1.5 cm/s: 50 nm took 3.3 us of a 40 us run)"))
+        "start, m: the pad is lowered until its face first meets the disc's, then raised "
+        "by this (0: touching; docs/braking.md 'Application')"))
     seed: int = Field(0, ge=0)
 
     @model_validator(mode="after")
