@@ -91,9 +91,9 @@ class GeometryCfg(StrictModel):
         "band of the one-junction cell (modes 1..4), so a cell n times as wide with n "
         "times the modes has the same asperities")
     clearance_m: float = Field(0.0, ge=0, **physical(
-        0.0, 1e-2, "m", "gap between the pad's lowest and the disc's highest point at the "
-        "start, m: the pad is lowered until its face first meets the disc's, then raised "
-        "by this (0: touching; docs/braking.md 'Application')"))
+        0.0, 1e-2, "m", "vertical gap at the start between the pad's and the disc's faces "
+        "where they first meet (the pad lowered rigidly until they touch, then raised by "
+        "this), m; 0: touching (docs/braking.md 'Application')"))
     seed: int = Field(0, ge=0)
 
     @model_validator(mode="after")
