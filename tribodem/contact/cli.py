@@ -14,7 +14,7 @@ from tribodem.io.config import ConfigError
 from tribodem.io.helptext import reflowed
 
 #: backends with closed-form checks
-SOLVERS = ("elastic", "fe")
+SOLVERS = ("elastic", "elastic-plastic", "fe")
 
 log = logging.getLogger(__name__)
 
@@ -31,7 +31,8 @@ def validate(
     ] = True,
 ) -> None:
     """Closed-form checks of a first-body backend: Hertz (point, line), Cattaneo-Mindlin,
-    gross slip (fe: also through the reversals of a full cycle), first yield. Errors are
+    gross slip (fe: also through the reversals of a full cycle), first yield
+    (elastic-plastic: with sliding friction mu = 0, 0.25, 0.5). Errors are
     relative, absolute (m) where the name says (m).
     Exit 0 when every check passes, 3 otherwise."""
     from tribodem.io.runs import RunStopped
@@ -60,6 +61,11 @@ def validate(
                 log.info("validate: the 3D crossed-cylinder checks (minutes of ccx; --no-3d "
                          "leaves them out)...")
                 checks += crossed_checks(Path(keep or tmp), threads=1)
+    elif solver == "elastic-plastic":
+        from tribodem.contact.validate import elastic_plastic_checks
+
+        log.info("validate: first yield with friction (about a minute)...")
+        checks = elastic_plastic_checks()
     else:
         from tribodem.contact.validate import halfspace_checks
 
