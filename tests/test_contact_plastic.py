@@ -133,3 +133,51 @@ def test_backend_capabilities_and_cycle_records():
                                  "tolerance": 1e-4}
     assert s.shakedown(rows[:2])["reached"] is False
     assert s.shakedown(rows[:2])["last_peeq_increment"] == 0.01
+
+
+def test_cycle_records_start_at_the_first_loading_and_carry_the_state():
+    """Two frictionless cycles of 4 increments at 10 N (p0 1.28 GPa = 1.9 Y) on coarse
+    grids (with mu 0.3 the reversal's traction jump of 2 mu p made the plastic solve
+    diverge: refused by the kernel, see the next test):
+    the first cycle's record includes the first loading (its increase of p equals the peak p
+    of the virgin body), the plastic state is carried (the peak never falls), every yielding
+    increment gives one step per body, and report() holds both cycles and a shakedown
+    statement."""
+    from tribodem.contact import cycle_offsets
+
+    s = ElastoPlasticSolver(load=10.0, friction=0.0, n=32, ep_n=8, ep_nz=5, amplitude=2e-5,
+                            load_steps=2)
+    s.solve_increment(0.0)  # the loop's first loading
+    peaks = []
+    for _ in range(2):
+        s.begin_cycle()
+        for off in cycle_offsets(2e-5, 4):
+            s.solve_increment(float(off))
+        peaks.append(s.cycle_columns())
+    rep = s.report()
+    rows = rep["cycles"]
+    assert len(rows) == 2 and rows[1] == peaks[1]
+    first = rows[0]
+    assert first["max_peeq_lower"] > 1e-4
+    assert first["peeq_increment_lower"] == pytest.approx(first["max_peeq_lower"], rel=1e-12)
+    assert rows[1]["max_peeq_lower"] >= first["max_peeq_lower"]
+    assert rows[1]["max_peeq_upper"] >= first["max_peeq_upper"]
+    assert set(rep["shakedown"]) >= {"reached", "tolerance"}
+    steps = s.plastic_steps()
+    assert steps and {st.body for st in steps} <= {"upper", "lower"}
+    assert all(st.dp.shape == st.stress.shape[:-1] for st in steps)
+
+
+def test_an_unbounded_plastic_increment_is_refused():
+    """At the reversal of mu = 0.3 gross slip (10 N, coarse grids) the traction jumps by
+    2 mu p and the plastic solve ran away (p of order 1e5 measured before this guard): the
+    kernel refuses an increment of p above 0.5 instead of returning it."""
+    from tribodem.contact import cycle_offsets
+
+    s = ElastoPlasticSolver(load=10.0, friction=0.3, n=32, ep_n=8, ep_nz=5, amplitude=2e-5,
+                            load_steps=2)
+    s.solve_increment(0.0)
+    s.begin_cycle()
+    with pytest.raises(RuntimeError, match="plastic strain increment|did not converge"):
+        for off in cycle_offsets(2e-5, 4):
+            s.solve_increment(float(off))

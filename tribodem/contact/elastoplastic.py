@@ -295,6 +295,7 @@ class ElastoPlasticSolver(HalfSpaceSolver):
         self._cycle_rows: list[dict[str, Any]] = []
         self._cycle_start: dict[str, NDArray[np.float64]] | None = None
         self._cycle_increments = 0
+        self._cycle_open = False
         #: coupling passes of every increment and load step solved (:meth:`_coupled`)
         self.coupling_passes: list[int] = []
 
@@ -311,6 +312,7 @@ class ElastoPlasticSolver(HalfSpaceSolver):
             "cycle_start": (None if self._cycle_start is None
                             else {b: v.copy() for b, v in self._cycle_start.items()}),
             "cycle_increments": self._cycle_increments,
+            "cycle_open": self._cycle_open,
         }
 
     def load_state_dict(self, state: dict[str, Any]) -> None:
@@ -324,6 +326,7 @@ class ElastoPlasticSolver(HalfSpaceSolver):
         cs = state["cycle_start"]
         self._cycle_start = None if cs is None else {b: np.array(v) for b, v in cs.items()}
         self._cycle_increments = int(state["cycle_increments"])
+        self._cycle_open = bool(state["cycle_open"])
         for b in BODIES:
             self._update_map(b)
 
@@ -423,10 +426,14 @@ class ElastoPlasticSolver(HalfSpaceSolver):
         self._loaded = True
 
     def begin_cycle(self) -> None:
-        """Close the previous cycle's record (:meth:`cycle_columns`) and start a new one."""
-        if self._cycle_start is not None and self._cycle_increments:
+        """Close the previous cycle's record (:meth:`cycle_columns`) and start a new one (the
+        first cycle's record starts at the first loading)."""
+        if self._cycle_open and self._cycle_increments:
             self._cycle_rows.append(self.cycle_columns())
-        self._cycle_start = {b: s.cumulated_plastic_strain for b, s in self.bodies.items()}
+        if self._cycle_open or self._cycle_start is None:
+            # (the first cycle keeps the start of the first loading: its record includes it)
+            self._cycle_start = {b: s.cumulated_plastic_strain for b, s in self.bodies.items()}
+        self._cycle_open = True
         self._cycle_increments = 0
 
     def solve_increment(self, offset: float) -> IncrementResult:
@@ -491,7 +498,7 @@ class ElastoPlasticSolver(HalfSpaceSolver):
         """Per cycle :meth:`cycle_columns` (``cycles``, the open cycle included), and the
         ``shakedown`` statement (:meth:`shakedown`)."""
         rows = list(self._cycle_rows)
-        if self._cycle_increments:
+        if self._cycle_open and self._cycle_increments:
             rows.append(self.cycle_columns())
         return {"cycles": rows, "shakedown": self.shakedown(rows),
                 "plastic_grid": {"dx_m": self.ep_dx, "nz": self.ep_nz,

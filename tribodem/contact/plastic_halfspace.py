@@ -175,9 +175,16 @@ class PlasticHalfSpace:
             return np.zeros((self.nz, self.nx, self.ny))
         before = self.cumulated_plastic_strain
         self._solve_increment(inc / self.unit, 0)
+        dp = np.maximum(self.cumulated_plastic_strain - before, 0.0)
+        if dp.max() > self.MAX_INCREMENT:
+            raise RuntimeError(
+                f"plastic strain increment {dp.max():.3g} in one traction increment (more than "
+                f"{self.MAX_INCREMENT}): outside the small-strain half-space, and the nonlinear "
+                "solve is not trustworthy there (a layer's uniform in-plane eigenstrain is "
+                "stress-free, so the residual has near-null directions); lower the load or the "
+                "friction, or refine the increments")
         self.traction = t.copy()
         self._residual_stress = None
-        dp = np.maximum(self.cumulated_plastic_strain - before, 0.0)
         if dp.max() > 0.0:
             eps_p = np.array(self._model["plastic_strain"], dtype=float)
             eig = np.zeros_like(eps_p)
@@ -189,6 +196,8 @@ class PlasticHalfSpace:
             self.residual_displacement = (u - border) * self.length
         return dp
 
+    #: the largest increment of p one load is allowed to give (else ``RuntimeError``)
+    MAX_INCREMENT = 0.5
     #: a solve is accepted when its residual is below this share of the initial one
     ACCEPT = 0.05
     #: ... or when its root mean square is below this strain (a yield strain is ~3e-3)
