@@ -102,21 +102,9 @@ def test_interface_geometry_and_boundary_conditions() -> None:
     p = it.sim.p
     disc, pad = p.group == DISC, p.group == PAD
     assert disc.any() and pad.any() and it.sim.box.periodic[0]
-    # pad above disc, lowered from its lowest point a clearance above the disc's highest
-    # point to where the faces first meet: lowered rigidly by a further clearance, its
-    # first pair would touch (brute force over all disc-pad pairs, minimum image in x: the
-    # least vertical drop (y_j - y_i) - sqrt((r_i + r_j)^2 - dx^2) over the pairs within
-    # reach in x), and no pair overlaps now
+    # pad above disc, its lowest point a clearance above the disc's highest point
     gap = (p.pos[pad, 1] - p.radius[pad]).min() - (p.pos[disc, 1] + p.radius[disc]).max()
-    assert gap <= SMALL.clearance + 1e-12
-    dx = p.pos[pad, 0][:, None] - p.pos[disc, 0][None, :]
-    dx -= it.width * np.rint(dx / it.width)
-    dy = p.pos[pad, 1][:, None] - p.pos[disc, 1][None, :]
-    s = p.radius[pad][:, None] + p.radius[disc][None, :]
-    reach = np.abs(dx) < s
-    drop = dy[reach] - np.sqrt(s[reach] ** 2 - dx[reach] ** 2)
-    assert drop.min() == pytest.approx(SMALL.clearance, abs=1e-12)
-    assert (np.hypot(dx, dy) - s).min() > 0.0
+    assert gap == pytest.approx(SMALL.clearance, abs=1e-12)
     # rough: the disc is cut by its profile (eq: rough_profile from the geometry's seed) and
     # its surface follows it: in each 10 um bin the highest centre lies between the lowest
     # profile height of the bin less one particle diameter and the highest (a flat cut at
@@ -152,11 +140,10 @@ def test_interface_geometry_and_boundary_conditions() -> None:
     start_sliding(it, 30.0)
     assert np.all(p.vel[disc, 0] == -30.0) and np.all(p.vel[pad, 0] == 0.0)
     ref = reference(it)
-    m = measure(it, ref, 0.0)  # the fresh cell: nothing detached, nothing worn
-    assert m["debris_particles"] == 0 and m["wear_depth_mean_m"] == 0.0
     it.sim.step(100)
     m = measure(it, ref, 30.0 * it.sim.time)
-    assert m["force_chains"] >= 0.9 * b.n_bonds - m["broken_bonds"]  # every loaded intact bond
+    assert m["debris_particles"] == 0 and m["wear_depth_mean_m"] == 0.0
+    assert m["force_chains"] >= 0.9 * b.n_bonds  # every loaded intact bond is a chain
     with pytest.raises(ValueError, match="width"):
         build_interface(Geometry(width=1e-6), 0.33e6)
 
@@ -622,9 +609,9 @@ def test_resume_in_process_equals_the_uninterrupted_run(tmp_path: Path,
     """Interrupted at the 8th sample (after the checkpoint of sample 6), then resumed:
     rows, pvd indexes, snapshots and summary are bitwise the uninterrupted run's; with
     the debris outlet too (its travel and store state are in the checkpoint); with the
-    feed (slabs of one diameter, so that the tiny cell's pad is fed before sample 12) the
+    feed (slabs of one diameter, so that the tiny cell is fed once, after sample 8) the
     run is interrupted at sample 12, after the feed's checkpoint, and the resume replays
-    the feeds before loading it."""
+    the feed before loading it."""
     import tribodem.braking.feed as feed_mod
     import tribodem.braking.loop as loop_mod
     from tribodem.braking.checkpoint import read_checkpoint
@@ -650,8 +637,8 @@ def test_resume_in_process_equals_the_uninterrupted_run(tmp_path: Path,
     rec = read_checkpoint(tmp_path / "b" / "checkpoint.npz")
     assert 0 < rec["done"] < rec["total_steps"] and not rec["finished"]
     if change.get("feed"):
-        assert rec["feed"]["events"] and set(rec["feed"]["events"]) == {
-            k for k, v in full["feed"]["slabs_fed"].items() if v} == {"pad"}, rec["feed"]
+        assert rec["feed"]["events"] == ["pad"] == [k for k, v in full["feed"][
+            "slabs_fed"].items() if v], rec["feed"]
     # checkpoint_every and figures may change on resume; the physics may not
     res = run_braking(_tiny({**change, "checkpoint_every": 5}), tmp_path / "b", resume=True)
     for k, v in full.items():
@@ -762,8 +749,6 @@ def test_default_cell_is_the_trend_study_cell_and_quick_one_junction() -> None:
     assert 11_000 < cell_particles(d) < 14_000
     q = resolve_config(quick=True)
     assert q.geometry.width_m == 144e-6 and q.geometry.roughness_first_mode == 1
-    # the default pad starts touching the disc, the quick one 50 nm above it, as before
-    assert d.geometry.clearance_m == 0.0 and q.geometry.clearance_m == 5e-8
     assert cell_particles(q) < cell_particles(d) / 20
     q16 = resolve_config({"geometry": {"roughness_first_mode": 16}}, quick=True)
     assert q16.geometry.roughness_first_mode == 1  # the preset's auto, not the file's 16

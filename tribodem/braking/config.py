@@ -90,10 +90,9 @@ class GeometryCfg(StrictModel):
         "ceil(roughness_modes / 4): wavelengths from width/modes to 4 width/modes, the "
         "band of the one-junction cell (modes 1..4), so a cell n times as wide with n "
         "times the modes has the same asperities")
-    clearance_m: float = Field(0.0, ge=0, **physical(
-        0.0, 1e-2, "m", "vertical gap at the start between the pad's and the disc's faces "
-        "where they first meet (the pad lowered rigidly until they touch, then raised by "
-        "this), m; 0: touching (docs/braking.md 'Application')"))
+    clearance_m: float = Field(5e-8, ge=0, **physical(
+        0.0, 1e-2, "m", "gap between the pad's lowest and the disc's highest point at the "
+        "start, m"))
     seed: int = Field(0, ge=0)
 
     @model_validator(mode="after")
@@ -183,8 +182,7 @@ class BrakingConfig(PhysicalConfig):
     def quick(cls) -> dict[str, Any]:
         """The ``--quick`` preset (a dict shaped like the TOML file, laid over the config):
         a cell one asperity junction wide (144 um, 3 modes of wavelengths 48-144 um) instead
-        of the default 16 junctions, a thinner disc (50 um), the pad 50 nm above the disc
-        at the start (the cell as it was before the default), 20 us of sliding: the pad is
+        of the default 16 junctions, a thinner disc (50 um), 20 us of sliding: the pad is
         then in contact only part of the time (docs/braking.md "Wider cells and more
         packings"). Its pad has the default height: a 50-um pad shattered under the first
         impacts at conditions 1-4 (worn through within 0.06-0.55 mm, docs/braking.md
@@ -192,7 +190,7 @@ class BrakingConfig(PhysicalConfig):
         return {
             "geometry": {"width_m": 144e-6, "disc_height_m": 50e-6, "pad_height_m": 108e-6,
                          "roughness_amplitude_m": 6e-6, "roughness_modes": 3,
-                         "roughness_first_mode": 0, "clearance_m": 5e-8},
+                         "roughness_first_mode": 0},
             "run": {"duration_s": 20e-6, "distance_m": 0.0, "samples": 100,
                     "vtk_snapshots": 4},
         }

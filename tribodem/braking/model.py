@@ -307,34 +307,6 @@ def profile_height(x: np.ndarray, width: float, prof: tuple[np.ndarray, ...]) ->
                                 + ph)).sum(axis=1)
 
 
-def first_contact_drop(pos: np.ndarray, radius: np.ndarray, upper: np.ndarray, width: float,
-                       band: float, chunk: int = 512) -> float:
-    """How far (m) the particles ``upper`` (the pad) can be lowered rigidly before one of
-    them touches one of the others (the disc), periodic in x with period ``width``: the
-    least ``(y_j - y_i) - sqrt((r_i + r_j)^2 - dx^2)`` over the pairs (i below, j above)
-    with ``|dx| < r_i + r_j`` (minimum image), among the particles within ``band`` (m) of
-    the lower body's top and the upper body's bottom; 0 when it is negative (already
-    touching) or no pair is within reach. Chunked over the upper band's particles."""
-    lo = ~upper
-    top = float((pos[lo, 1] + radius[lo]).max())
-    bottom = float((pos[upper, 1] - radius[upper]).min())
-    i = np.flatnonzero(lo & (pos[:, 1] + radius > top - band))
-    j = np.flatnonzero(upper & (pos[:, 1] - radius < bottom + band))
-    best = np.inf
-    for k in range(0, j.size, chunk):
-        jj = j[k:k + chunk]
-        dx = pos[jj, 0][:, None] - pos[i, 0][None, :]
-        dx -= width * np.rint(dx / width)
-        s = radius[jj][:, None] + radius[i][None, :]
-        reach = np.abs(dx) < s
-        if not reach.any():
-            continue
-        drop = (pos[jj, 1][:, None] - pos[i, 1][None, :]) - np.sqrt(
-            np.where(reach, s * s - dx * dx, 0.0))
-        best = min(best, float(drop[reach].min()))
-    return max(best, 0.0) if np.isfinite(best) else 0.0
-
-
 def pairs_periodic(pos: np.ndarray, radius: np.ndarray, width: float, gap: float,
                    height: float | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Pairs (i < j) with surface gap < ``gap`` (m), periodic in x (and in y with period
@@ -588,11 +560,9 @@ def build_interface(geometry: Geometry, pressure_Pa: float, micro: str = "calibr
     # pad down rigidly until the closest disc-pad surface gap is the clearance
     pd = group == PAD
     # braking starts with the pad applied to the already sliding disc: its lowest point a
-    # clearance above the disc's highest point, then lowered to where the faces first meet
+    # clearance above the disc's highest point
     gap = float((pos[pd, 1] - radii[pd]).min() - (pos[~pd, 1] + radii[~pd]).max())
     pos[pd, 1] -= gap - g.clearance
-    drop = first_contact_drop(pos, radii, pd, w, 2.0 * g.amplitude + 4.0 * rmax)
-    pos[pd, 1] -= max(drop - g.clearance, 0.0)
     # anchors: one mean diameter from the outer faces
     dm = 2.0 * float(radii.mean())
     bottom = float((pos[~pd, 1] - radii[~pd]).min())
