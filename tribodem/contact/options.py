@@ -58,13 +58,6 @@ class PlasticOptions(StrictModel):
     load_steps: int = Field(4, ge=1, le=100, description="first-loading steps")
     ep_tolerance: float = Field(1e-6, gt=0, lt=0.1,
                                 description="plastic solve tolerance (elastic-plastic)")
-    ep_iterations: int = Field(4, ge=1, le=100, description="contact-plasticity passes "
-                               "of an increment that yields, at most (elastic-plastic)")
-    ep_coupling_tolerance: float = Field(
-        0.02, gt=0, lt=1, description="coupling converged: peak pressure change between "
-        "passes below this share of the peak pressure (elastic-plastic)")
-    ep_relaxation: float = Field(0.5, gt=0, le=1, description="relaxation of the residual "
-                                 "displacement between passes (elastic-plastic)")
     shakedown_tolerance: float = Field(
         1e-4, gt=0, lt=1, description="shakedown: a cycle's largest increase of the "
         "equivalent plastic strain below this (elastic-plastic)")

@@ -97,6 +97,14 @@ class PlasticHalfSpace:
         self.hardening = check_positive("hardening", hardening, allow_zero=True)
         self.tolerance = check_positive("tolerance", tolerance)
         self.max_iter = int(max_iter)
+        self._build()
+        self.reset()
+
+    def _build(self) -> None:
+        """Fresh tamaas objects (model, material, residual, solver; the operators' model).
+        A :class:`tamaas.Residual` keeps state beyond the model's fields: one rebuilt from
+        the fields of a yielded state does not continue it (its residual 20-50 % apart,
+        measured), so only an unyielded state is restored exactly."""
         a = self.length
         dims = [self.depth / a, self.nx * self.dx / a, self.ny * self.dx / a]
         shape = [self.nz, self.nx, self.ny]
@@ -117,7 +125,6 @@ class PlasticHalfSpace:
         self._aux = tm.ModelFactory.createModel(tm.model_type.volume_2d, dims, shape)
         self._aux.E, self._aux.nu = self._model.E, self._model.nu
         tm.ModelFactory.registerVolumeOperators(self._aux)
-        self.reset()
 
     @property
     def x(self) -> NDArray[np.float64]:
@@ -252,11 +259,15 @@ class PlasticHalfSpace:
     def state_dict(self) -> dict[str, Any]:
         """The body's state (tamaas fields, applied traction, residual displacement)."""
         return {"fields": model_fields(self._model), "traction": self.traction.copy(),
-                "residual_displacement": self.residual_displacement.copy()}
+                "residual_displacement": self.residual_displacement.copy(),
+                "guess": np.array(self._nl.getStrainIncrement(), dtype=float)}
 
     def load_state_dict(self, state: dict[str, Any]) -> None:
-        """Restore :meth:`state_dict` (same grid)."""
+        """Restore :meth:`state_dict` (same grid) into fresh tamaas objects."""
+        self._build()
         set_model_fields(self._model, state["fields"])
+        # the nonlinear solver starts from its last solution: restored with the state
+        np.asarray(self._nl.getStrainIncrement())[...] = state["guess"]
         self.traction = np.array(state["traction"], dtype=float)
         self.residual_displacement = np.array(state["residual_displacement"], dtype=float)
         self._residual_stress = None
