@@ -190,3 +190,22 @@ def test_gross_slip_shakes_down_and_a_yielded_state_does_not_resume():
     assert s.report()["shakedown"]["reached"] and s.report()["shakedown"]["cycle"] == 2
     with pytest.raises(ConfigError, match="cannot resume"):
         ElastoPlasticSolver(**kw).load_state_dict(s.state_dict())
+
+
+def test_a_plastic_increment_beyond_small_strains_stops_the_run():
+    """A Hertz traction at p0 = 2.35 Y with q = 0.6 p applied at once on a coarse kernel
+    (12 x 12 x 5, a / 3 cells): p would rise by more than 0.5 in the surface layer (0.40 on
+    a / 6.4 cells, measured; here checked against a bound of 0.01), so the kernel stops with
+    PlasticSolveStopped (the loop's early stop, exit 3), the traction not taken as applied."""
+    from tribodem.contact.fe.ccx import FESolverStopped
+    from tribodem.contact.plastic_halfspace import PlasticSolveStopped
+
+    a = 1e-4
+    s = PlasticHalfSpace(nx=12, ny=12, nz=5, dx=a / 3, depth=a, x0=-2 * a, y0=-2 * a,
+                         young=240e9, poisson=NU, yield_strength=680e6, hardening=2.5e9,
+                         length=a)
+    s.MAX_INCREMENT = 0.01  # type: ignore[misc]  (a tighter bound for a quick test)
+    with pytest.raises(PlasticSolveStopped, match="plastic strain increment") as err:
+        s.load(_hertz(s, 1.6e9, 1.2 * a, 0.6))
+    assert isinstance(err.value, FESolverStopped)
+    assert not np.any(s.traction)

@@ -35,7 +35,14 @@ import tamaas as tm
 from numpy.typing import NDArray
 
 from tribodem.contact.base import check_positive
+from tribodem.contact.fe.ccx import FESolverStopped
 from tribodem.contact.halfspace import model_fields, set_model_fields
+
+
+class PlasticSolveStopped(FESolverStopped):
+    """The plastic solve cannot go on (no convergence, or an increase of the equivalent
+    plastic strain beyond small strains in one increment); like a stopped finite-element
+    solve, a fretting run stops early with this message and keeps its outputs (exit 3)."""
 
 
 def mandel_to_voigt(a: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -173,7 +180,8 @@ class PlasticHalfSpace:
         [nx, ny, 3]; p > 0 compressive) from the one applied now; returns the increment of
         the cumulated plastic strain, - [nz, nx, ny]. Updates the residual surface
         displacement (Mindlin's normal displacement of C : eps_p at z = 0, its mean over
-        the grid's border taken as zero: the periodic grid fixes it up to a constant)."""
+        the grid's border taken as zero: the periodic grid fixes it up to a constant).
+        :class:`PlasticSolveStopped` when p would rise by more than :attr:`MAX_INCREMENT`."""
         t = np.asarray(traction, dtype=float)
         if t.shape != (self.nx, self.ny, 3):
             raise ValueError(f"traction of shape {t.shape}: expected ({self.nx}, {self.ny}, 3)")
@@ -184,7 +192,7 @@ class PlasticHalfSpace:
         self._solve_increment(inc / self.unit, 0)
         dp = np.maximum(self.cumulated_plastic_strain - before, 0.0)
         if dp.max() > self.MAX_INCREMENT:
-            raise RuntimeError(
+            raise PlasticSolveStopped(
                 f"plastic strain increment {dp.max():.3g} in one traction increment (more than "
                 f"{self.MAX_INCREMENT}): outside the small-strain half-space, and the nonlinear "
                 "solve is not trustworthy there (a layer's uniform in-plane eigenstrain is "
@@ -203,7 +211,7 @@ class PlasticHalfSpace:
             self.residual_displacement = (u - border) * self.length
         return dp
 
-    #: the largest increment of p one load is allowed to give (else ``RuntimeError``)
+    #: the largest increment of p one load may give (else :class:`PlasticSolveStopped`)
     MAX_INCREMENT = 0.5
     #: a solve is accepted when its residual is below this share of the initial one
     ACCEPT = 0.05
@@ -216,7 +224,7 @@ class PlasticHalfSpace:
         """Solve and commit the (non-dimensional) traction increment ``inc``; a solve whose
         residual norm stays above :attr:`ACCEPT` x the initial one and above an RMS of
         :attr:`FLOOR` (the nonlinear solver stopped at ``max_iter``) is not committed: the
-        increment is halved, up to :attr:`MAX_SPLITS` times (then ``RuntimeError``)."""
+        increment is halved, up to :attr:`MAX_SPLITS` times (then :class:`PlasticSolveStopped`)."""
         self._model.traction[...] = inc
         zero = np.zeros((self.nz, self.nx, self.ny, 6))
         self._res.computeResidual(zero)
@@ -230,7 +238,7 @@ class PlasticHalfSpace:
             self._res.updateState(x)
             return
         if depth >= self.MAX_SPLITS:
-            raise RuntimeError(
+            raise PlasticSolveStopped(
                 f"plastic solve did not converge (residual {r / r0:.3g} of the initial one "
                 f"after {self.MAX_SPLITS} halvings of the traction increment): the traction "
                 "is beyond what the half-space's small-strain plasticity carries; lower the "
