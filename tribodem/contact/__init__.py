@@ -4,7 +4,8 @@ One contract, :class:`FirstBodySolver` with its :class:`Capabilities`, driven th
 fretting cycles by :class:`tribodem.fretting.FrettingLoop`. Backends, registered by name in
 :data:`BACKENDS` (a new backend is one module here plus one line there):
 ``elastic`` :class:`HalfSpaceSolver` (elastic half-space BEM on tamaas) and
-``elastic-plastic`` :class:`ElastoPlasticSolver` (tamaas EPIC, bilinear EN24T), ``fe``
+``elastic-plastic`` :class:`ElastoPlasticSolver` (semi-analytical elastic-plastic
+half-space with friction on tamaas's volume operators, bilinear EN24T), ``fe``
 :class:`FEContactSolver` (CalculiX, plane strain) and ``fe3d`` :class:`FE3DContactSolver`
 (CalculiX, 3D crossed cylinders). Each backend is built from a resolved case
 (:class:`ContactCase`) and the config tables it reads (:attr:`FirstBodySolver.options`:
