@@ -96,9 +96,24 @@ def test_a_record_of_config_version_5_reads_one_update_a_cycle() -> None:
 
     old = {**CASE, "config_version": 5, "wear": {"criterion": "archard"}}
     read = recorded_config(old)
-    assert read["config_version"] == CONFIG_VERSION == 6
+    assert read["config_version"] == CONFIG_VERSION == 7
     assert read["wear"] == {"criterion": "archard", "update_tolerance": 0.0}
     assert FrettingConfig.model_validate(read).wear.update_tolerance == 0.0
     named = recorded_config({**old, "wear": {"update_tolerance": 0.1}})
     assert named["wear"]["update_tolerance"] == 0.1
-    assert recorded_config({**CASE, "config_version": 6}) == {**CASE, "config_version": 6}
+    assert recorded_config({**CASE, "config_version": 7}) == {**CASE, "config_version": 7}
+
+
+def test_a_record_of_config_version_6_keeps_the_fe3d_morph_it_ran() -> None:
+    """fe3d records before config_version 7 morphed by the lumped projection without a
+    kink limit: read so (a record that names them keeps them; other solvers unchanged)."""
+    from tribodem.fretting.config import recorded_config
+
+    old = {"solver": "fe3d", "config_version": 6, "fe": {"threads": 2}}
+    read = recorded_config(old)
+    assert read["fe"] == {"morph": "projection", "max_wear_kink": "off", "threads": 2}
+    cfg = FrettingConfig.model_validate(read)
+    assert cfg.fe.morph == "projection" and cfg.fe.max_wear_kink is None
+    named = recorded_config({**old, "fe": {"morph": "tributary"}})
+    assert named["fe"]["morph"] == "tributary"
+    assert "fe" not in recorded_config({"solver": "elastic", "config_version": 6})

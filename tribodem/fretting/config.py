@@ -321,7 +321,10 @@ class OutputConfig(StrictModel):
 #: "plane-strain": a line contact on one cross-section; the n x n periodic window before).
 #: 6: ``[wear] update_tolerance`` (default 0.05: a cycle that wears more than that share of
 #: the elastic approach is split into sub-cycles; one geometry update a cycle before).
-CONFIG_VERSION = 6
+#: 7: ``[fe] morph`` (default "tributary": fe3d's surface nodes take their exact tributary
+#: share of the wear maps) and ``[fe] max_wear_kink`` (default 0.03); fe3d morphed by the
+#: lumped projection without a kink limit before.
+CONFIG_VERSION = 7
 
 
 #: ``--quick``: a 64^2 window, 10 cycles, a coarser subsurface grid and a shorter debris
@@ -499,12 +502,19 @@ def recorded_config(data: Mapping[str, Any]) -> dict[str, Any]:
     the elastic backend solved a line contact on the n x n periodic window: ``[elastic]
     line_model`` is set to "periodic-2d" in the records of line-contact runs. Before
     version 6 the geometry was updated once a cycle: ``[wear] update_tolerance`` is set to
-    0 where the record leaves it out.
+    0 where the record leaves it out. Before version 7 fe3d morphed its meshes by the lumped
+    projection without a kink limit: in fe3d records that leave them out ``[fe] morph`` is
+    set to "projection" and ``max_wear_kink`` to "off".
     """
     data = dict(data)
     version = data.get("config_version", 1)
-    if version == CONFIG_VERSION or version not in (1, 2, 3, 4, 5):
+    if version == CONFIG_VERSION or version not in (1, 2, 3, 4, 5, 6):
         return data
+    if data.get("solver") == "fe3d":
+        fe_old = dict(data["fe"]) if isinstance(data.get("fe"), dict) else {}
+        data["fe"] = {"morph": "projection", "max_wear_kink": "off", **fe_old}
+    if version == 6:
+        return {**data, "config_version": CONFIG_VERSION}
     wear = dict(data["wear"]) if isinstance(data.get("wear"), dict) else {}
     data["wear"] = {"update_tolerance": 0.0, **wear}
     if version == 5:
@@ -554,12 +564,12 @@ def effective_config(data: Mapping[str, Any]) -> dict[str, Any]:
 #: Config fields a resumed run may change: ``cycles`` (raised, to extend a run), the
 #: ``[output]`` table (what is written, not the numbers), how ccx runs (threads, time limit,
 #: job cache) and, to go on from a stopped finite-element cycle, its retries, the worn
-#: surface's slope limit and the friction while loading (the cycles after the resume are
-#: then another run's: each cycle's ``wear_slope_limit`` and ``loading_mu`` in summary.json
-#: say what it ran with).
+#: surface's morph, slope and kink limits and the friction while loading (the cycles after
+#: the resume are then another run's: each cycle's ``wear_slope_limit``,
+#: ``wear_kink_limit``, ``morph`` and ``loading_mu`` in summary.json say what it ran with).
 RESUME_MAY_CHANGE = ("cycles", "output.", "fe.threads", "fe.timeout", "fe.cache",
-                     "fe.retries", "fe.retry_from", "fe.max_wear_slope",
-                     "fe.loading_friction")
+                     "fe.retries", "fe.retry_from", "fe.max_wear_slope", "fe.morph",
+                     "fe.max_wear_kink", "fe.loading_friction")
 
 
 def resume_diffs(old_cfg: Mapping[str, Any], new_cfg: Mapping[str, Any],
