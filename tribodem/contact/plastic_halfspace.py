@@ -34,15 +34,15 @@ import numpy as np
 import tamaas as tm
 from numpy.typing import NDArray
 
-from tribodem.contact.base import check_positive
-from tribodem.contact.fe.ccx import FESolverStopped
+from tribodem.contact.base import WindowTooSmallError, check_positive
 from tribodem.contact.halfspace import model_fields, set_model_fields
 
 
-class PlasticSolveStopped(FESolverStopped):
+class PlasticSolveStopped(WindowTooSmallError):
     """The plastic solve cannot go on (no convergence, or an increase of the equivalent
-    plastic strain beyond small strains in one increment); like a stopped finite-element
-    solve, a fretting run stops early with this message and keeps its outputs (exit 3)."""
+    plastic strain beyond small strains in one increment). A subclass of the error the
+    fretting loop already stops on (the contact leaving the window): the run stops early
+    with this message and keeps its outputs (exit 3)."""
 
 
 def mandel_to_voigt(a: NDArray[np.float64]) -> NDArray[np.float64]:
