@@ -78,15 +78,16 @@ def _third_party_imports() -> set[str]:
 
 
 def test_every_runtime_import_is_a_declared_dependency() -> None:
-    """Each package tribodem imports is a dependency, or (dask) in the extra ``cluster``;
-    the extra ``test`` holds the cluster's packages, ``docs`` mkdocs."""
+    """Each package tribodem imports is a dependency, or (dask) in the extra ``cluster``
+    (with dask-jobqueue, for the batch-cluster example); the extra ``test`` holds the
+    cluster's packages, ``docs`` mkdocs."""
     proj = _pyproject()["project"]
     deps = _requirement_names(proj["dependencies"])
     extras = {k: _requirement_names(v) for k, v in proj["optional-dependencies"].items()}
     for name in sorted(_third_party_imports()):
         dist = DIST.get(name, name).lower()
         assert dist in deps or dist in extras["cluster"], name
-    assert "dask" not in deps and extras["cluster"] == {"dask"}
+    assert "dask" not in deps and extras["cluster"] == {"dask", "dask-jobqueue"}
     assert extras["cluster"] <= extras["test"]
     assert {"mkdocs", "mkdocstrings"} <= extras["docs"]
     assert {"pytest", "pytest-xdist", "hypothesis", "ruff", "import-linter"} <= extras["test"]

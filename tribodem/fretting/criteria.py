@@ -573,9 +573,8 @@ class DFDICriterion(Criterion):
     stresses' ranges over the cycle and sigma_eq the *sum over all nodes* of the von Mises
     ranges, so the exponent is ~0 and eps_f = 1.65 eps0 everywhere; DFDI is then the peak
     equivalent plastic strain / (1.65 eps0)). Needs a solver with the
-    ``plastic`` capability (:class:`tribodem.contact.ElastoPlasticSolver`: one plastic
-    state shared by both bodies; ``fe`` with ``material = "elastic-plastic"``: one per
-    body, :attr:`PlasticStep.body`).
+    ``plastic`` capability (:class:`tribodem.contact.ElastoPlasticSolver` and ``fe`` with
+    ``material = "elastic-plastic"``: one plastic state per body, :attr:`PlasticStep.body`).
     """
 
     name = "dfdi"

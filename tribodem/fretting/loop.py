@@ -338,17 +338,23 @@ class FrettingLoop:
         du, dl, per = self._solve_pass()
         m = self._subcycles(du, dl, per["contact_area_m2"])
         if m > 1:  # the cycle again in m passes, each adding 1/m of its wear
+            start = (self.wear_upper, self.wear_lower)
             du, dl = du / m, dl / m
             self.wear_upper = self.wear_upper + du
             self.wear_lower = self.wear_lower + dl
             passes = [per]
-            for _ in range(m - 1):
+            try:
+                for _ in range(m - 1):
+                    self._apply_geometry()
+                    du_k, dl_k, per_k = self._solve_pass()
+                    du, dl = du + du_k / m, dl + dl_k / m
+                    self.wear_upper = self.wear_upper + du_k / m
+                    self.wear_lower = self.wear_lower + dl_k / m
+                    passes.append(per_k)
+            except Exception:  # a stop inside the cycle: its wear is not kept (atomic)
+                self.wear_upper, self.wear_lower = start
                 self._apply_geometry()
-                du_k, dl_k, per_k = self._solve_pass()
-                du, dl = du + du_k / m, dl + dl_k / m
-                self.wear_upper = self.wear_upper + du_k / m
-                self.wear_lower = self.wear_lower + dl_k / m
-                passes.append(per_k)
+                raise
             per = {k: (max(p[k] for p in passes) if k.startswith("max_")
                        else sum(p[k] for p in passes) / m) for k in per}
         else:
@@ -368,7 +374,7 @@ class FrettingLoop:
         """One pass of the stroke on the current surfaces: (the wear depth it gives the
         upper and the lower body, m; its dissipated energy J, largest pressure and traction
         Pa, mean contact area m^2)."""
-        self.solver.begin_cycle()  # the solver's hook (elastic-plastic: EPIC at full load)
+        self.solver.begin_cycle()  # the solver's hook (ccx: the cycle's job)
         crit = self.criterion
         crit.begin_cycle(self.grid, self.solver)
         cell = self.grid.cell_area
