@@ -337,29 +337,26 @@ class FrettingLoop:
                 extra |= self._de_phase()
         du, dl, per = self._solve_pass()
         m = self._subcycles(du, dl, per["contact_area_m2"])
-        if m > 1:  # the cycle again in m passes, each adding 1/m of its wear
-            start = (self.wear_upper, self.wear_lower)
-            du, dl = du / m, dl / m
-            self.wear_upper = self.wear_upper + du
-            self.wear_lower = self.wear_lower + dl
-            passes = [per]
-            try:
-                for _ in range(m - 1):
-                    self._apply_geometry()
-                    du_k, dl_k, per_k = self._solve_pass()
-                    du, dl = du + du_k / m, dl + dl_k / m
-                    self.wear_upper = self.wear_upper + du_k / m
-                    self.wear_lower = self.wear_lower + dl_k / m
-                    passes.append(per_k)
-            except Exception:  # a stop inside the cycle: its wear is not kept (atomic)
-                self.wear_upper, self.wear_lower = start
+        # the cycle in m passes, each adding 1/m of its wear (m = 1: x / 1 is x, bitwise)
+        start = (self.wear_upper, self.wear_lower)
+        du, dl = du / m, dl / m
+        self.wear_upper, self.wear_lower = start[0] + du, start[1] + dl
+        passes = [per]
+        try:
+            for _ in range(m - 1):
                 self._apply_geometry()
-                raise
+                du_k, dl_k, per_k = self._solve_pass()
+                du, dl = du + du_k / m, dl + dl_k / m
+                self.wear_upper = self.wear_upper + du_k / m
+                self.wear_lower = self.wear_lower + dl_k / m
+                passes.append(per_k)
+        except Exception:  # a stop inside the cycle: its wear is not kept (atomic)
+            self.wear_upper, self.wear_lower = start
+            self._apply_geometry()
+            raise
+        if m > 1:
             per = {k: (max(p[k] for p in passes) if k.startswith("max_")
                        else sum(p[k] for p in passes) / m) for k in per}
-        else:
-            self.wear_upper = self.wear_upper + du
-            self.wear_lower = self.wear_lower + dl
         self._last_du, self._last_dl = du, dl
         self._generate_debris(du, dl)
         if self.debris is not None:

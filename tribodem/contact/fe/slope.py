@@ -108,6 +108,18 @@ def steepest(depth: NDArray[np.float64], xs: NDArray[np.float64], ys: NDArray[np
                            np.ascontiguousarray(ys, dtype=float)))
 
 
+def _surface_arrays(depth: NDArray[np.float64], xs: NDArray[np.float64],
+                    ys: NDArray[np.float64], area: NDArray[np.float64]
+                    ) -> tuple[NDArray[np.float64], ...]:
+    """``depth`` [ny, nx], ``xs`` [nx], ``ys`` [ny] and ``area`` [ny, nx] as contiguous
+    float arrays (``ValueError`` if the shapes do not fit)."""
+    w0, xs, ys, area = (np.ascontiguousarray(a, dtype=float) for a in (depth, xs, ys, area))
+    if w0.shape != (ys.size, xs.size) or area.shape != w0.shape:
+        raise ValueError(f"depth {w0.shape} and area {area.shape} must be (ny, nx) = "
+                         f"({ys.size}, {xs.size})")
+    return w0, xs, ys, area
+
+
 def limit_slope(depth: NDArray[np.float64], xs: NDArray[np.float64], ys: NDArray[np.float64],
                 area: NDArray[np.float64], slope: float) -> tuple[NDArray[np.float64], SlopeLimit]:
     """``depth`` (m, [ny, nx], >= 0: the worn depth of each column of the grid ``xs`` x
@@ -115,13 +127,7 @@ def limit_slope(depth: NDArray[np.float64], xs: NDArray[np.float64], ys: NDArray
     ``slope`` (dimensionless, > 0) x the edge length, within :data:`TOLERANCE`; ``area``
     (m^2, [ny, nx]) the columns' tributary areas, whose weighted sum of the depths (the worn
     volume) is kept. Returns the relaxed copy and a :class:`SlopeLimit`."""
-    w0 = np.ascontiguousarray(depth, dtype=float)
-    xs = np.ascontiguousarray(xs, dtype=float)
-    ys = np.ascontiguousarray(ys, dtype=float)
-    area = np.ascontiguousarray(area, dtype=float)
-    if w0.shape != (ys.size, xs.size) or area.shape != w0.shape:
-        raise ValueError(f"depth {w0.shape} and area {area.shape} must be (ny, nx) = "
-                         f"({ys.size}, {xs.size})")
+    w0, xs, ys, area = _surface_arrays(depth, xs, ys, area)
     if not (np.isfinite(slope) and slope > 0.0):
         raise ValueError(f"slope = {slope!r} is not allowed: a number > 0")
     if np.any(np.diff(xs) <= 0) or np.any(np.diff(ys) <= 0) or np.any(area <= 0):
@@ -264,13 +270,7 @@ def limit_kink(depth: NDArray[np.float64], xs: NDArray[np.float64], ys: NDArray[
     combination of old ones (>= 0, never deeper than the deepest), and a surface within
     both limits is returned bit for bit. The sweeps stop when nothing exceeds the limits
     (``converged``) or after :data:`MAX_SWEEPS` (still volume-exact)."""
-    w0 = np.ascontiguousarray(depth, dtype=float)
-    xs = np.ascontiguousarray(xs, dtype=float)
-    ys = np.ascontiguousarray(ys, dtype=float)
-    area = np.ascontiguousarray(area, dtype=float)
-    if w0.shape != (ys.size, xs.size) or area.shape != w0.shape:
-        raise ValueError(f"depth {w0.shape} and area {area.shape} must be (ny, nx) = "
-                         f"({ys.size}, {xs.size})")
+    w0, xs, ys, area = _surface_arrays(depth, xs, ys, area)
     for name, v in (("kink", kink), ("slope", slope)):
         if not (v > 0.0) or np.isnan(v):
             raise ValueError(f"{name} = {v!r} is not allowed: a number > 0")
